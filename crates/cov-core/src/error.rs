@@ -1,0 +1,159 @@
+//! The one error type of cov-core.
+
+use crate::Axis;
+
+/// Everything that can go wrong in cov-core and in operators built on it.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum CovError {
+    /// A parameter is NaN or infinite where a finite value is required.
+    #[error("{operator}: parameter `{parameter}` must be finite, got {value}")]
+    NonFinite {
+        /// Operator or function that rejected the value.
+        operator: String,
+        /// Name of the parameter.
+        parameter: String,
+        /// The rejected value.
+        value: f64,
+    },
+    /// A parameter is finite but outside its domain.
+    #[error("{operator}: parameter `{parameter}` = {value} is out of range: {expected}")]
+    OutOfRange {
+        /// Operator or function that rejected the value.
+        operator: String,
+        /// Name of the parameter.
+        parameter: String,
+        /// The rejected value.
+        value: f64,
+        /// What the domain is, in words (e.g. "must be > 0").
+        expected: String,
+    },
+    /// An operator needs an axis the layout does not have.
+    #[error("axis `{axis}` is not in the layout of size {layout}")]
+    MissingAxis {
+        /// The axis asked for.
+        axis: Axis,
+        /// The layout size N.
+        layout: usize,
+    },
+    /// A matrix or slice has the wrong shape.
+    #[error("{what}: expected {expected}, got {got}")]
+    Shape {
+        /// What was being built.
+        what: String,
+        /// Expected shape, in words.
+        expected: String,
+        /// Shape that was given.
+        got: String,
+    },
+    /// A matrix given as a covariance is not symmetric.
+    #[error("matrix is not symmetric: entry ({row},{col}) = {a} but ({col},{row}) = {b}")]
+    NotSymmetric {
+        /// Row of the offending entry.
+        row: usize,
+        /// Column of the offending entry.
+        col: usize,
+        /// Value at (row, col).
+        a: f64,
+        /// Value at (col, row).
+        b: f64,
+    },
+    /// A matrix given as a covariance is not positive semi-definite.
+    #[error("matrix is not positive semi-definite: smallest eigenvalue {min_eigenvalue:e} (tolerance {tolerance:e})")]
+    NotPsd {
+        /// The smallest eigenvalue found.
+        min_eigenvalue: f64,
+        /// The tolerance it was compared against (negative).
+        tolerance: f64,
+    },
+    /// A result overflowed or became NaN (an operator was applied to values too large
+    /// for f64).
+    #[error("{operator}: result is not finite (entry ({row},{col}) = {value}); the input or parameters overflow f64")]
+    Overflow {
+        /// Operator whose result overflowed.
+        operator: String,
+        /// Row of the first non-finite entry.
+        row: usize,
+        /// Column of the first non-finite entry.
+        col: usize,
+        /// The non-finite value.
+        value: f64,
+    },
+    /// A physical situation in which no light passes (e.g. total internal reflection
+    /// asked for a transmitted ray).
+    #[error("{operator}: {reason}")]
+    NoTransport {
+        /// Operator that found it.
+        operator: String,
+        /// Why nothing is transported.
+        reason: String,
+    },
+    /// A step of a chain failed; wraps the error with the step index and name.
+    #[error("step {index} ({operator}): {source}")]
+    Step {
+        /// Zero-based index of the step in the chain.
+        index: usize,
+        /// Name of the operator at that step.
+        operator: String,
+        /// The error it returned.
+        source: Box<CovError>,
+    },
+}
+
+impl CovError {
+    /// Checks that `value` is finite; the error names the operator and parameter.
+    ///
+    /// # Errors
+    /// [`CovError::NonFinite`] if `value` is NaN or infinite.
+    pub fn check_finite(operator: &str, parameter: &str, value: f64) -> Result<f64, CovError> {
+        if value.is_finite() {
+            Ok(value)
+        } else {
+            Err(CovError::NonFinite {
+                operator: operator.into(),
+                parameter: parameter.into(),
+                value,
+            })
+        }
+    }
+
+    /// Checks that `value` is finite and satisfies `ok`; otherwise an
+    /// [`CovError::OutOfRange`] with `expected` as the explanation.
+    ///
+    /// # Errors
+    /// [`CovError::NonFinite`] or [`CovError::OutOfRange`].
+    pub fn check_range(
+        operator: &str,
+        parameter: &str,
+        value: f64,
+        ok: impl FnOnce(f64) -> bool,
+        expected: &str,
+    ) -> Result<f64, CovError> {
+        Self::check_finite(operator, parameter, value)?;
+        if ok(value) {
+            Ok(value)
+        } else {
+            Err(CovError::OutOfRange {
+                operator: operator.into(),
+                parameter: parameter.into(),
+                value,
+                expected: expected.into(),
+            })
+        }
+    }
+
+    /// Checks that `value` is finite and strictly positive.
+    ///
+    /// # Errors
+    /// [`CovError::NonFinite`] or [`CovError::OutOfRange`].
+    pub fn check_positive(operator: &str, parameter: &str, value: f64) -> Result<f64, CovError> {
+        Self::check_range(operator, parameter, value, |v| v > 0.0, "must be > 0")
+    }
+
+    /// Checks that `value` is finite and non-negative.
+    ///
+    /// # Errors
+    /// [`CovError::NonFinite`] or [`CovError::OutOfRange`].
+    pub fn check_non_negative(operator: &str, parameter: &str, value: f64) -> Result<f64, CovError> {
+        Self::check_range(operator, parameter, value, |v| v >= 0.0, "must be >= 0")
+    }
+}

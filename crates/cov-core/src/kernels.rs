@@ -1,0 +1,352 @@
+//! The shared kernels: the four algebraic rules of PHYSICS.md section 2 as in-place
+//! operations on [`Cov`]. Operator crates compose these instead of re-deriving them; each
+//! kernel is tested against a dense nalgebra reference (`tests/kernels.rs`).
+//!
+//! Every kernel keeps Σ exactly symmetric (packed storage) and rejects non-finite
+//! parameters. Kernels named by primal effect: "shear `target` by `source`" means the
+//! primal map `l'(z) = l(z')` with `z'_target = z_target + s·z_source`.
+
+use nalgebra::SMatrix;
+
+use crate::linalg::{MAX, Small, psd_pinv, sym_eigen};
+use crate::{Axis, Cov, CovError, PSD_RTOL};
+
+impl<const N: usize> Cov<N> {
+    /// Rule 1 with a dense matrix: `l'(z) = l(A z)` gives `Σ' = Aᵀ Σ A`.
+    ///
+    /// # Errors
+    /// A non-finite entry in `a`, or an overflowing result.
+    pub fn congruence(&mut self, a: &SMatrix<f64, N, N>) -> Result<(), CovError> {
+        if a.iter().any(|v| !v.is_finite()) {
+            return Err(CovError::NonFinite {
+                operator: "congruence".into(),
+                parameter: "A".into(),
+                value: a.iter().copied().find(|v| !v.is_finite()).unwrap_or(f64::NAN),
+            });
+        }
+        // B = Σ A, then Σ'_ij = Σ_k A_ki B_kj for i ≤ j only (exact symmetry).
+        let mut b = [[0.0; N]; N];
+        for (k, row) in b.iter_mut().enumerate() {
+            for (j, v) in row.iter_mut().enumerate() {
+                *v = (0..N).map(|l| self.get(k, l) * a[(l, j)]).sum();
+            }
+        }
+        let old = *self;
+        for i in 0..N {
+            for j in i..N {
+                self.set(i, j, (0..N).map(|k| a[(k, i)] * b[k][j]).sum());
+            }
+        }
+        self.finish("congruence", old)
+    }
+
+    /// Rule 1, elementary shear: `l'(z) = l(z')` with `z'_target = z_target + s·z_source`.
+    ///
+    /// In the spectrum this adds `s ×` row/column `target` to row/column `source`.
+    /// Travel by `d` is `shear(X, U, −d)`; curvature `k` is `shear(U, X, k)`.
+    ///
+    /// # Errors
+    /// Missing axis, `target == source`, non-finite `s`, or an overflowing result.
+    pub fn shear(&mut self, target: Axis, source: Axis, s: f64) -> Result<(), CovError> {
+        CovError::check_finite("shear", "s", s)?;
+        let i = Self::index(target)?;
+        let j = Self::index(source)?;
+        if i == j {
+            return Err(CovError::Shape {
+                what: "shear".into(),
+                expected: "two different axes".into(),
+                got: format!("{target} and {source}"),
+            });
+        }
+        if s == 0.0 {
+            return Ok(());
+        }
+        let old = *self;
+        self.shear_idx(i, j, s);
+        self.finish("shear", old)
+    }
+
+    #[inline(always)]
+    pub(crate) fn shear_idx(&mut self, i: usize, j: usize, s: f64) {
+        let sii = self.get(i, i);
+        let sij = self.get(i, j);
+        let sjj = self.get(j, j);
+        for k in 0..N {
+            if k != j {
+                let v = self.get(k, j) + s * self.get(k, i);
+                self.set(k, j, v);
+            }
+        }
+        self.set(j, j, sjj + s * (2.0 * sij + s * sii));
+    }
+
+    /// Rule 1, scaling: `l'(z) = l(z')` with `z'_axis = c·z_axis` (a projection by a
+    /// cosine is `scale(X, cos θ)`). Row and column `axis` of Σ are multiplied by `c`.
+    ///
+    /// # Errors
+    /// Missing axis, non-finite `c`, or an overflowing result.
+    pub fn scale(&mut self, axis: Axis, c: f64) -> Result<(), CovError> {
+        CovError::check_finite("scale", "c", c)?;
+        let i = Self::index(axis)?;
+        let old = *self;
+        for k in 0..N {
+            let v = self.get(k, i) * c;
+            self.set(k, i, v);
+        }
+        let v = self.get(i, i) * c;
+        self.set(i, i, v);
+        self.finish("scale", old)
+    }
+
+    /// Rule 1, rotation in the plane of two axes: `l'(z) = l(z')` with
+    /// `(z'_a, z'_b) = (cos α·z_a − sin α·z_b, sin α·z_a + cos α·z_b)`, α in radians.
+    ///
+    /// # Errors
+    /// Missing axis, `a == b`, non-finite `angle`.
+    pub fn rotate(&mut self, a: Axis, b: Axis, angle: f64) -> Result<(), CovError> {
+        CovError::check_finite("rotate", "angle", angle)?;
+        let i = Self::index(a)?;
+        let j = Self::index(b)?;
+        if i == j {
+            return Err(CovError::Shape {
+                what: "rotate".into(),
+                expected: "two different axes".into(),
+                got: format!("{a} and {b}"),
+            });
+        }
+        let (s, c) = angle.sin_cos();
+        let old = *self;
+        self.rotate_idx(i, j, c, s);
+        self.finish("rotate", old)
+    }
+
+    #[inline(always)]
+    fn rotate_idx(&mut self, i: usize, j: usize, c: f64, s: f64) {
+        let sii = self.get(i, i);
+        let sij = self.get(i, j);
+        let sjj = self.get(j, j);
+        for k in 0..N {
+            if k != i && k != j {
+                let ki = self.get(k, i);
+                let kj = self.get(k, j);
+                self.set(k, i, c * ki + s * kj);
+                self.set(k, j, c * kj - s * ki);
+            }
+        }
+        let cs = c * s;
+        self.set(i, i, c * c * sii + 2.0 * cs * sij + s * s * sjj);
+        self.set(j, j, s * s * sii - 2.0 * cs * sij + c * c * sjj);
+        self.set(i, j, cs * (sjj - sii) + (c * c - s * s) * sij);
+    }
+
+    /// Rotation of the 3D tangent frame by `angle` (radians): `(x, y)` and `(u, v)` turn
+    /// together, as [`Cov::rotate`] on both pairs.
+    ///
+    /// # Errors
+    /// [`CovError::MissingAxis`] in flatland (N = 2, 3); non-finite `angle`.
+    pub fn rotate_frame(&mut self, angle: f64) -> Result<(), CovError> {
+        CovError::check_finite("rotate_frame", "angle", angle)?;
+        let (x, y, u, v) = (
+            Self::index(Axis::X)?,
+            Self::index(Axis::Y)?,
+            Self::index(Axis::U)?,
+            Self::index(Axis::V)?,
+        );
+        let (s, c) = angle.sin_cos();
+        let old = *self;
+        self.rotate_idx(x, y, c, s);
+        self.rotate_idx(u, v, c, s);
+        self.finish("rotate_frame", old)
+    }
+
+    /// Rule 2 on one axis: multiplying the primal by a window adds its spectrum variance,
+    /// `Σ_aa += w` ((cycles/unit)²). A Gaussian window of std `s` has `w = 1/(4π²s²)`.
+    ///
+    /// # Errors
+    /// Missing axis, `w` negative or non-finite, overflow.
+    pub fn add_variance(&mut self, axis: Axis, w: f64) -> Result<(), CovError> {
+        CovError::check_non_negative("add_variance", "w", w)?;
+        let i = Self::index(axis)?;
+        let old = *self;
+        let v = self.get(i, i) + w;
+        self.set(i, i, v);
+        self.finish("add_variance", old)
+    }
+
+    /// Rule 2: `Σ' = Σ + W`, with `W` the spectrum covariance of the window on `axes`,
+    /// given row-major as `axes.len()²` numbers (symmetric PSD).
+    ///
+    /// # Errors
+    /// Missing or repeated axis, wrong size, `W` not finite, symmetric and PSD; overflow.
+    pub fn add_window(&mut self, axes: &[Axis], w: &[f64]) -> Result<(), CovError> {
+        let (idx, k) = self.resolve("add_window", axes)?;
+        let wm = block_from_slice("add_window", "W", k, w)?;
+        let old = *self;
+        for a in 0..k {
+            for b in a..k {
+                let v = self.get(idx[a], idx[b]) + wm[a][b];
+                self.set(idx[a], idx[b], v);
+            }
+        }
+        self.finish("add_window", old)
+    }
+
+    /// Rule 3: convolution along `axes` with a lobe whose spectrum covariance is `S`
+    /// (row-major, `axes.len()²` numbers, symmetric PSD):
+    /// `Σ' = Σ − Σ Pᵀ (S + P Σ Pᵀ)⁻¹ P Σ`, computed without inverting Σ.
+    ///
+    /// The convolved block and the cross terms use the forms `Σ_pp (S+Σ_pp)⁻¹ S` and
+    /// `Σ_op (S+Σ_pp)⁻¹ S`, which are exactly zero for `S = 0` (a perfectly diffuse lobe
+    /// removes all content on those axes) and tend to the identity as `S → ∞` (a mirror:
+    /// callers skip the kernel). A singular `S + Σ_pp` uses the pseudo-inverse.
+    ///
+    /// # Errors
+    /// Missing or repeated axis, wrong size, `S` not finite/symmetric/PSD; overflow.
+    pub fn convolve(&mut self, axes: &[Axis], s: &[f64]) -> Result<(), CovError> {
+        let (idx, k) = self.resolve("convolve", axes)?;
+        let sm = block_from_slice("convolve", "S", k, s)?;
+        let old = *self;
+        self.lobe_product(&idx[..k], &sm);
+        self.finish("convolve", old)
+    }
+
+    /// Rule 4, in place: integration of the primal over `axes` (lens, shutter, sensor
+    /// angle). The kept block becomes the Schur complement
+    /// `Σ_kk − Σ_kr Σ_rr⁺ Σ_rk` (pseudo-inverse where Σ_rr is singular) and the
+    /// integrated axes become 0: the integrated field no longer depends on them, i.e. it is
+    /// constant along them. The same as [`Cov::convolve`] with `S = 0`.
+    ///
+    /// An integrated axis with zero variance contributes nothing (`Σ_rr⁺ = 0` there).
+    ///
+    /// # Errors
+    /// Missing or repeated axis.
+    pub fn integrate(&mut self, axes: &[Axis]) -> Result<(), CovError> {
+        let (idx, k) = self.resolve("integrate", axes)?;
+        let old = *self;
+        self.lobe_product(&idx[..k], &[[0.0; MAX]; MAX]);
+        self.finish("integrate", old)
+    }
+
+    /// Shared by rules 3 and 4; `p` are the convolved indices, `s` the lobe spectrum.
+    fn lobe_product(&mut self, p: &[usize], s: &Small) {
+        let k = p.len();
+        let mut m = [[0.0; MAX]; MAX];
+        for a in 0..k {
+            for b in 0..k {
+                m[a][b] = s[a][b] + self.get(p[a], p[b]);
+            }
+        }
+        let (minv, _) = psd_pinv(k, &m);
+        // T = M⁺ S (k×k).
+        let mut t = [[0.0; MAX]; MAX];
+        for a in 0..k {
+            for b in 0..k {
+                t[a][b] = (0..k).map(|c| minv[a][c] * s[c][b]).sum();
+            }
+        }
+        let others: Vec<usize> = (0..N).filter(|i| !p.contains(i)).collect();
+        let old = *self;
+        // Σ_oo − Σ_op M⁺ Σ_po
+        for (ai, &oa) in others.iter().enumerate() {
+            // g = Σ_{oa,p} M⁺
+            let mut g = [0.0; MAX];
+            for (c, gc) in g.iter_mut().enumerate().take(k) {
+                *gc = (0..k).map(|d| old.get(oa, p[d]) * minv[d][c]).sum();
+            }
+            for &ob in &others[ai..] {
+                let corr: f64 = (0..k).map(|c| g[c] * old.get(p[c], ob)).sum();
+                self.set(oa, ob, old.get(oa, ob) - corr);
+            }
+        }
+        // Σ_op M⁺ S
+        for &o in &others {
+            for b in 0..k {
+                let v: f64 = (0..k).map(|c| old.get(o, p[c]) * t[c][b]).sum();
+                self.set(o, p[b], v);
+            }
+        }
+        // ½ (Σ_pp M⁺ S + S M⁺ Σ_pp): symmetrised, PSD analytically.
+        for a in 0..k {
+            for b in a..k {
+                let ab: f64 = (0..k).map(|c| old.get(p[a], p[c]) * t[c][b]).sum();
+                let ba: f64 = (0..k).map(|c| old.get(p[b], p[c]) * t[c][a]).sum();
+                self.set(p[a], p[b], 0.5 * (ab + ba));
+            }
+        }
+    }
+
+    fn resolve(&self, op: &str, axes: &[Axis]) -> Result<([usize; MAX], usize), CovError> {
+        let mut idx = [0usize; MAX];
+        if axes.is_empty() || axes.len() > N {
+            return Err(CovError::Shape {
+                what: op.into(),
+                expected: format!("1 to {N} axes"),
+                got: format!("{} axes", axes.len()),
+            });
+        }
+        for (a, axis) in axes.iter().enumerate() {
+            idx[a] = Self::index(*axis)?;
+            if idx[..a].contains(&idx[a]) {
+                return Err(CovError::Shape {
+                    what: op.into(),
+                    expected: "distinct axes".into(),
+                    got: format!("`{axis}` twice"),
+                });
+            }
+        }
+        Ok((idx, axes.len()))
+    }
+
+    /// Checks the result of a kernel; on overflow restores the input and reports.
+    fn finish(&mut self, op: &str, old: Self) -> Result<(), CovError> {
+        if let Err(e) = self.check_finite(op) {
+            *self = old;
+            return Err(e);
+        }
+        Ok(())
+    }
+}
+
+/// Reads a `k × k` row-major symmetric PSD block (a window or lobe spectrum).
+pub(crate) fn block_from_slice(op: &str, name: &str, k: usize, w: &[f64]) -> Result<Small, CovError> {
+    if w.len() != k * k {
+        return Err(CovError::Shape {
+            what: format!("{op}: {name}"),
+            expected: format!("{} numbers ({k}×{k} row-major)", k * k),
+            got: format!("{} numbers", w.len()),
+        });
+    }
+    let mut m = [[0.0; MAX]; MAX];
+    let mut scale = 0.0f64;
+    for a in 0..k {
+        for b in 0..k {
+            let v = CovError::check_finite(op, name, w[a * k + b])?;
+            m[a][b] = v;
+            scale = scale.max(v.abs());
+        }
+    }
+    for a in 0..k {
+        for b in (a + 1)..k {
+            if (m[a][b] - m[b][a]).abs() > 1e-12 * scale {
+                return Err(CovError::NotSymmetric {
+                    row: a,
+                    col: b,
+                    a: m[a][b],
+                    b: m[b][a],
+                });
+            }
+            let avg = 0.5 * (m[a][b] + m[b][a]);
+            m[a][b] = avg;
+            m[b][a] = avg;
+        }
+    }
+    let (vals, _) = sym_eigen(k, &m);
+    let tol = PSD_RTOL * vals[..k].iter().fold(0.0f64, |acc, v| acc.max(v.abs()));
+    if vals[0] < -tol {
+        return Err(CovError::NotPsd {
+            min_eigenvalue: vals[0],
+            tolerance: -tol,
+        });
+    }
+    Ok(m)
+}

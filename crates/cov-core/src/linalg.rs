@@ -1,0 +1,287 @@
+//! Small symmetric matrices (size 1 to 5): the eigen-solver and pseudo-inverse that the
+//! kernels use. Tested against nalgebra.
+//!
+//! Everything here works on a full `[[f64; 5]; 5]` array of which the leading `n × n`
+//! block is used, so that the kernels never allocate.
+
+/// Largest matrix size handled here (the 5D layout).
+pub const MAX: usize = 5;
+
+/// A full `n × n` symmetric block stored in a fixed array (only `[..n][..n]` is used).
+pub type Small = [[f64; MAX]; MAX];
+
+/// Relative tolerance of the pseudo-inverse (dimensionless).
+///
+/// After scaling a PSD matrix to unit diagonal (so the tolerance does not depend on the
+/// units of the axes), eigenvalues at or below `PINV_RCOND × λ_max` are treated as zero.
+/// `1e-12` is about 4500 ulps: well above the rounding noise of the eigen-solver on a
+/// 5×5 matrix (a few ulps × n), well below any correlation that carries information.
+pub const PINV_RCOND: f64 = 1e-12;
+
+/// Eigen-decomposition of the symmetric `n × n` block of `a` by cyclic Jacobi rotations.
+///
+/// Returns the eigenvalues (ascending) and the eigenvectors as the columns of the second
+/// array. The matrix is scaled by its largest entry first, so entries anywhere in
+/// `1e-300 … 1e300` neither overflow nor underflow. Non-finite input gives non-finite
+/// eigenvalues (callers check finiteness first).
+pub fn sym_eigen(n: usize, a: &Small) -> ([f64; MAX], Small) {
+    let mut vals = [0.0; MAX];
+    let mut vecs = [[0.0; MAX]; MAX];
+    for (i, row) in vecs.iter_mut().enumerate().take(n) {
+        row[i] = 1.0;
+    }
+    let mut scale = 0.0f64;
+    for row in a.iter().take(n) {
+        for v in row.iter().take(n) {
+            scale = scale.max(v.abs());
+        }
+    }
+    if scale == 0.0 || !scale.is_finite() {
+        for (i, v) in vals.iter_mut().enumerate().take(n) {
+            *v = if scale == 0.0 { 0.0 } else { a[i][i] };
+        }
+        return (vals, vecs);
+    }
+    let mut b = [[0.0; MAX]; MAX];
+    for i in 0..n {
+        for j in 0..n {
+            // Symmetrise while scaling: the solver relies on exact symmetry.
+            b[i][j] = 0.5 * (a[i][j] + a[j][i]) / scale;
+        }
+    }
+    for sweep in 0..100 {
+        let mut off = 0.0;
+        for i in 0..n {
+            for j in (i + 1)..n {
+                off += b[i][j].abs();
+            }
+        }
+        if off == 0.0 {
+            break;
+        }
+        for p in 0..n {
+            for q in (p + 1)..n {
+                let bpq = b[p][q];
+                if bpq == 0.0 {
+                    continue;
+                }
+                // Negligible against both diagonal entries: drop it (after a few sweeps, as
+                // in the classical cyclic Jacobi method).
+                let g = 100.0 * bpq.abs();
+                if sweep > 3 && b[p][p].abs() + g == b[p][p].abs() && b[q][q].abs() + g == b[q][q].abs() {
+                    b[p][q] = 0.0;
+                    b[q][p] = 0.0;
+                    continue;
+                }
+                let h = b[q][q] - b[p][p];
+                let t = if h.abs() + g == h.abs() {
+                    bpq / h
+                } else {
+                    let theta = 0.5 * h / bpq;
+                    let t = 1.0 / (theta.abs() + (1.0 + theta * theta).sqrt());
+                    if theta < 0.0 { -t } else { t }
+                };
+                let c = 1.0 / (1.0 + t * t).sqrt();
+                let s = t * c;
+                let tau = s / (1.0 + c);
+                let hh = t * bpq;
+                b[p][p] -= hh;
+                b[q][q] += hh;
+                b[p][q] = 0.0;
+                b[q][p] = 0.0;
+                for r in 0..n {
+                    if r != p && r != q {
+                        let g = b[r][p];
+                        let h = b[r][q];
+                        b[r][p] = g - s * (h + g * tau);
+                        b[p][r] = b[r][p];
+                        b[r][q] = h + s * (g - h * tau);
+                        b[q][r] = b[r][q];
+                    }
+                }
+                for row in vecs.iter_mut().take(n) {
+                    let g = row[p];
+                    let h = row[q];
+                    row[p] = g - s * (h + g * tau);
+                    row[q] = h + s * (g - h * tau);
+                }
+            }
+        }
+    }
+    // Sort ascending (selection sort, n ≤ 5), moving eigenvector columns along.
+    for i in 0..n {
+        vals[i] = b[i][i] * scale;
+    }
+    for i in 0..n {
+        let mut m = i;
+        for j in (i + 1)..n {
+            if vals[j] < vals[m] {
+                m = j;
+            }
+        }
+        if m != i {
+            vals.swap(i, m);
+            for row in vecs.iter_mut().take(n) {
+                row.swap(i, m);
+            }
+        }
+    }
+    (vals, vecs)
+}
+
+/// A symmetric reflexive generalised inverse `G` of a symmetric positive semi-definite
+/// `n × n` block `M` (`M G M = M`, `G M G = G`): the inverse when `M` is non-singular.
+///
+/// For a singular `M` this is `D⁻¹ C⁺ D⁻¹`, not the Moore–Penrose inverse of `M`; it is
+/// what the Schur complement `Σ_kk − Σ_kr G Σ_rk` and the lobe product need, whose
+/// results are the same for every generalised inverse when the off-diagonal block lies in
+/// the range of `M` (always true for a PSD Σ).
+///
+/// The matrix is first scaled to unit diagonal (`M = D C D`, `D = diag(√M_ii)`), which
+/// makes the rank decision independent of the units of the axes; eigenvalues of `C` at or
+/// below [`PINV_RCOND`]` × λ_max(C)` (negative rounding noise included) count as zero.
+/// Rows with a zero (or negative) diagonal are treated as zero rows. Returns the
+/// pseudo-inverse and the numerical rank.
+pub fn psd_pinv(n: usize, m: &Small) -> (Small, usize) {
+    let mut d = [0.0; MAX];
+    for i in 0..n {
+        d[i] = if m[i][i] > 0.0 { m[i][i].sqrt() } else { 0.0 };
+    }
+    let mut c = [[0.0; MAX]; MAX];
+    for i in 0..n {
+        for j in 0..n {
+            if d[i] > 0.0 && d[j] > 0.0 {
+                c[i][j] = (m[i][j] / d[i]) / d[j];
+            }
+        }
+    }
+    let (vals, vecs) = sym_eigen(n, &c);
+    let lmax = vals[..n].iter().fold(0.0f64, |acc, v| acc.max(*v));
+    let tol = PINV_RCOND * lmax;
+    let mut out = [[0.0; MAX]; MAX];
+    let mut rank = 0;
+    for k in 0..n {
+        if vals[k] > tol && vals[k] > 0.0 {
+            rank += 1;
+            let inv = 1.0 / vals[k];
+            for i in 0..n {
+                for j in 0..n {
+                    out[i][j] += vecs[i][k] * vecs[j][k] * inv;
+                }
+            }
+        }
+    }
+    for i in 0..n {
+        for j in 0..n {
+            if d[i] > 0.0 && d[j] > 0.0 {
+                out[i][j] = (out[i][j] / d[i]) / d[j];
+            } else {
+                out[i][j] = 0.0;
+            }
+        }
+    }
+    (out, rank)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use nalgebra::DMatrix;
+
+    fn to_small(m: &DMatrix<f64>) -> Small {
+        let mut a = [[0.0; MAX]; MAX];
+        for i in 0..m.nrows() {
+            for j in 0..m.ncols() {
+                a[i][j] = m[(i, j)];
+            }
+        }
+        a
+    }
+
+    #[test]
+    fn eigen_matches_nalgebra() {
+        let mut seed = 12345u64;
+        let mut rnd = || {
+            seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            ((seed >> 11) as f64 / (1u64 << 53) as f64) * 2.0 - 1.0
+        };
+        for n in 1..=5 {
+            for _ in 0..50 {
+                let l = DMatrix::from_fn(n, n, |_, _| rnd());
+                let m = &l * l.transpose();
+                let (vals, vecs) = sym_eigen(n, &to_small(&m));
+                let mut reference: Vec<f64> = m.clone().symmetric_eigen().eigenvalues.iter().copied().collect();
+                reference.sort_by(|a, b| a.total_cmp(b));
+                let norm = m.norm();
+                for k in 0..n {
+                    assert!((vals[k] - reference[k]).abs() <= 1e-13 * norm, "n={n} {vals:?} {reference:?}");
+                    // A v = λ v
+                    for i in 0..n {
+                        let av: f64 = (0..n).map(|j| m[(i, j)] * vecs[j][k]).sum();
+                        assert!((av - vals[k] * vecs[i][k]).abs() <= 1e-12 * norm);
+                    }
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn eigen_extreme_scales() {
+        for s in [1e-300, 1e300] {
+            let a = [
+                [2.0 * s, s, 0.0, 0.0, 0.0],
+                [s, 2.0 * s, 0.0, 0.0, 0.0],
+                [0.0; 5],
+                [0.0; 5],
+                [0.0; 5],
+            ];
+            let (vals, _) = sym_eigen(2, &a);
+            assert!((vals[0] / s - 1.0).abs() < 1e-14);
+            assert!((vals[1] / s - 3.0).abs() < 1e-14);
+        }
+    }
+
+    #[test]
+    fn pinv_matches_inverse_and_handles_rank_deficiency() {
+        let m = DMatrix::from_row_slice(3, 3, &[4.0, 1.0, 0.5, 1.0, 3.0, 0.2, 0.5, 0.2, 2.0]);
+        let inv = m.clone().try_inverse().unwrap();
+        let (p, rank) = psd_pinv(3, &to_small(&m));
+        assert_eq!(rank, 3);
+        for i in 0..3 {
+            for j in 0..3 {
+                assert!((p[i][j] - inv[(i, j)]).abs() < 1e-14);
+            }
+        }
+        // Rank one: v vᵀ with v = (1, 2, 0); pinv = v vᵀ / |v|⁴.
+        let v = [1.0, 2.0, 0.0];
+        let mut a = [[0.0; MAX]; MAX];
+        for i in 0..3 {
+            for j in 0..3 {
+                a[i][j] = v[i] * v[j];
+            }
+        }
+        let (p, rank) = psd_pinv(3, &a);
+        assert_eq!(rank, 1);
+        let mul = |x: &Small, y: &Small| {
+            let mut o = [[0.0; MAX]; MAX];
+            for i in 0..3 {
+                for j in 0..3 {
+                    o[i][j] = (0..3).map(|k| x[i][k] * y[k][j]).sum();
+                }
+            }
+            o
+        };
+        let aga = mul(&mul(&a, &p), &a);
+        let gag = mul(&mul(&p, &a), &p);
+        for i in 0..3 {
+            for j in 0..3 {
+                assert!((aga[i][j] - a[i][j]).abs() < 1e-13, "AGA != A");
+                assert!((gag[i][j] - p[i][j]).abs() < 1e-13, "GAG != G");
+                assert_eq!(p[i][j], p[j][i]);
+            }
+        }
+        let (p, rank) = psd_pinv(2, &[[0.0; MAX]; MAX]);
+        assert_eq!(rank, 0);
+        assert_eq!(p, [[0.0; MAX]; MAX]);
+    }
+}
