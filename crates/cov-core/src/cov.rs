@@ -5,9 +5,9 @@ use std::fmt;
 
 use nalgebra::SMatrix;
 
+use crate::CovError;
 use crate::axis::{Axis, axis_index, layout_axes};
 use crate::linalg::{MAX, Small, sym_eigen};
-use crate::CovError;
 
 /// `4π²`: the factor between a Gaussian's primal covariance and its spectrum covariance
 /// (`Σ = C⁻¹ / 4π²`, PHYSICS.md section 1).
@@ -137,7 +137,11 @@ impl<const N: usize> Cov<N> {
                     expected: "must be > 0 (f64::INFINITY for a constant axis)".into(),
                 });
             }
-            let v = if s.is_infinite() { 0.0 } else { 1.0 / (FOUR_PI_SQ * s * s) };
+            let v = if s.is_infinite() {
+                0.0
+            } else {
+                1.0 / (FOUR_PI_SQ * s * s)
+            };
             if !v.is_finite() {
                 return Err(CovError::OutOfRange {
                     operator: "Cov::gaussian".into(),
@@ -571,7 +575,10 @@ mod tests {
         let ok = SMatrix::<f64, 2, 2>::new(2.0, 1.0, 1.0, 2.0);
         assert!(Cov::from_matrix(&ok).is_ok());
         let asym = SMatrix::<f64, 2, 2>::new(2.0, 1.0, 0.5, 2.0);
-        assert!(matches!(Cov::from_matrix(&asym), Err(CovError::NotSymmetric { .. })));
+        assert!(matches!(
+            Cov::from_matrix(&asym),
+            Err(CovError::NotSymmetric { .. })
+        ));
         let neg = SMatrix::<f64, 2, 2>::new(1.0, 2.0, 2.0, 1.0);
         assert!(matches!(Cov::from_matrix(&neg), Err(CovError::NotPsd { .. })));
         let nan = SMatrix::<f64, 2, 2>::new(1.0, f64::NAN, f64::NAN, 1.0);

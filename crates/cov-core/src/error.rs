@@ -58,7 +58,9 @@ pub enum CovError {
         b: f64,
     },
     /// A matrix given as a covariance is not positive semi-definite.
-    #[error("matrix is not positive semi-definite: smallest eigenvalue {min_eigenvalue:e} (tolerance {tolerance:e})")]
+    #[error(
+        "matrix is not positive semi-definite: smallest eigenvalue {min_eigenvalue:e} (tolerance {tolerance:e})"
+    )]
     NotPsd {
         /// The smallest eigenvalue found.
         min_eigenvalue: f64,
@@ -67,7 +69,9 @@ pub enum CovError {
     },
     /// A result overflowed or became NaN (an operator was applied to values too large
     /// for f64).
-    #[error("{operator}: result is not finite (entry ({row},{col}) = {value}); the input or parameters overflow f64")]
+    #[error(
+        "{operator}: result is not finite (entry ({row},{col}) = {value}); the input or parameters overflow f64"
+    )]
     Overflow {
         /// Operator whose result overflowed.
         operator: String,

@@ -10,12 +10,13 @@ pub const MAX: usize = 5;
 /// A full `n × n` symmetric block stored in a fixed array (only `[..n][..n]` is used).
 pub type Small = [[f64; MAX]; MAX];
 
-/// Relative tolerance of the pseudo-inverse (dimensionless).
+/// Rank tolerance of the generalised inverse [`psd_pinv`] (dimensionless).
 ///
 /// After scaling a PSD matrix to unit diagonal (so the tolerance does not depend on the
-/// units of the axes), eigenvalues at or below `PINV_RCOND × λ_max` are treated as zero.
-/// `1e-12` is about 4500 ulps: well above the rounding noise of the eigen-solver on a
-/// 5×5 matrix (a few ulps × n), well below any correlation that carries information.
+/// units of the axes), a pivot of its `LDLᵀ` factorisation at or below `PINV_RCOND` ends
+/// the factorisation: the remaining directions count as zero (correlation `1 − 1e-12`
+/// is treated as exact). `1e-12` is about 4500 ulps: above the rounding noise of a 5×5
+/// factorisation, below any correlation that carries information.
 pub const PINV_RCOND: f64 = 1e-12;
 
 /// Eigen-decomposition of the symmetric `n × n` block of `a` by cyclic Jacobi rotations.
@@ -131,53 +132,101 @@ pub fn sym_eigen(n: usize, a: &Small) -> ([f64; MAX], Small) {
 
 /// A symmetric reflexive generalised inverse `G` of a symmetric positive semi-definite
 /// `n × n` block `M` (`M G M = M`, `G M G = G`): the inverse when `M` is non-singular.
+/// Returns `G` and the numerical rank.
 ///
-/// For a singular `M` this is `D⁻¹ C⁺ D⁻¹`, not the Moore–Penrose inverse of `M`; it is
-/// what the Schur complement `Σ_kk − Σ_kr G Σ_rk` and the lobe product need, whose
-/// results are the same for every generalised inverse when the off-diagonal block lies in
-/// the range of `M` (always true for a PSD Σ).
+/// Method: `M` is scaled to unit diagonal (`M = D C D`, `D = diag(√M_ii)`), which makes
+/// the rank decision independent of the units of the axes; `C` is factored by an
+/// `LDLᵀ` decomposition with diagonal pivoting (rank revealing for PSD matrices), stopping
+/// when the largest remaining pivot is at most [`PINV_RCOND`] (the scaled diagonal is 1).
+/// With `r` pivots taken, `G = D⁻¹ Pᵀ [C₁₁⁻¹ 0; 0 0] P D⁻¹`, `C₁₁` the pivoted leading
+/// `r × r` block. Rows with a zero (or negative) diagonal are zero rows.
 ///
-/// The matrix is first scaled to unit diagonal (`M = D C D`, `D = diag(√M_ii)`), which
-/// makes the rank decision independent of the units of the axes; eigenvalues of `C` at or
-/// below [`PINV_RCOND`]` × λ_max(C)` (negative rounding noise included) count as zero.
-/// Rows with a zero (or negative) diagonal are treated as zero rows. Returns the
-/// pseudo-inverse and the numerical rank.
+/// For a singular `M` this is not the Moore–Penrose inverse; it is what the Schur
+/// complement `Σ_kk − Σ_kr G Σ_rk` and the lobe product need, whose results are the same
+/// for every generalised inverse when the off-diagonal block lies in the range of `M`
+/// (always true for a PSD Σ). Unlike an eigen-decomposition, the triangular factors keep
+/// small off-diagonal entries to relative accuracy, which matters once `D` is undone.
 pub fn psd_pinv(n: usize, m: &Small) -> (Small, usize) {
     let mut d = [0.0; MAX];
     for i in 0..n {
         d[i] = if m[i][i] > 0.0 { m[i][i].sqrt() } else { 0.0 };
     }
-    let mut c = [[0.0; MAX]; MAX];
+    // Only rows with a positive diagonal take part.
+    let mut act = [0usize; MAX];
+    let mut na = 0;
     for i in 0..n {
-        for j in 0..n {
-            if d[i] > 0.0 && d[j] > 0.0 {
-                c[i][j] = (m[i][j] / d[i]) / d[j];
-            }
+        if d[i] > 0.0 {
+            act[na] = i;
+            na += 1;
         }
     }
-    let (vals, vecs) = sym_eigen(n, &c);
-    let lmax = vals[..n].iter().fold(0.0f64, |acc, v| acc.max(*v));
-    let tol = PINV_RCOND * lmax;
-    let mut out = [[0.0; MAX]; MAX];
+    let mut a = [[0.0; MAX]; MAX];
+    for x in 0..na {
+        for y in 0..na {
+            let (i, j) = (act[x], act[y]);
+            a[x][y] = if x == y { 1.0 } else { (m[i][j] / d[i]) / d[j] };
+        }
+    }
+    // LDLᵀ with diagonal pivoting: after step k, a[k..][k..] holds the Schur complement.
+    let mut perm = [0usize; MAX];
+    for (x, p) in perm.iter_mut().enumerate() {
+        *p = x;
+    }
+    let mut l = [[0.0; MAX]; MAX];
+    let mut piv = [0.0; MAX];
     let mut rank = 0;
-    for k in 0..n {
-        if vals[k] > tol && vals[k] > 0.0 {
-            rank += 1;
-            let inv = 1.0 / vals[k];
-            for i in 0..n {
-                for j in 0..n {
-                    out[i][j] += vecs[i][k] * vecs[j][k] * inv;
-                }
+    for k in 0..na {
+        let mut p = k;
+        for x in (k + 1)..na {
+            if a[x][x] > a[p][p] {
+                p = x;
             }
         }
-    }
-    for i in 0..n {
-        for j in 0..n {
-            if d[i] > 0.0 && d[j] > 0.0 {
-                out[i][j] = (out[i][j] / d[i]) / d[j];
-            } else {
-                out[i][j] = 0.0;
+        if a[p][p].is_nan() || a[p][p] <= PINV_RCOND {
+            break;
+        }
+        if p != k {
+            a.swap(p, k);
+            for row in a.iter_mut() {
+                row.swap(p, k);
             }
+            l.swap(p, k);
+            perm.swap(p, k);
+        }
+        piv[k] = a[k][k];
+        l[k][k] = 1.0;
+        for x in (k + 1)..na {
+            l[x][k] = a[x][k] / piv[k];
+        }
+        for x in (k + 1)..na {
+            for y in (k + 1)..na {
+                a[x][y] -= l[x][k] * l[y][k] * piv[k];
+            }
+        }
+        rank += 1;
+    }
+    // C₁₁⁻¹ = L₁⁻ᵀ D₁⁻¹ L₁⁻¹ with L₁ unit lower triangular (r × r).
+    let r = rank;
+    let mut li = [[0.0; MAX]; MAX];
+    for col in 0..r {
+        li[col][col] = 1.0;
+        for x in (col + 1)..r {
+            let s: f64 = (col..x).map(|y| l[x][y] * li[y][col]).sum();
+            li[x][col] = -s;
+        }
+    }
+    let mut ginv = [[0.0; MAX]; MAX];
+    for x in 0..r {
+        for y in 0..r {
+            let s: f64 = (x.max(y)..r).map(|z| li[z][x] * li[z][y] / piv[z]).sum();
+            ginv[x][y] = s;
+        }
+    }
+    let mut out = [[0.0; MAX]; MAX];
+    for x in 0..r {
+        for y in 0..r {
+            let (i, j) = (act[perm[x]], act[perm[y]]);
+            out[i][j] = (ginv[x][y] / d[i]) / d[j];
         }
     }
     (out, rank)
@@ -202,7 +251,9 @@ mod tests {
     fn eigen_matches_nalgebra() {
         let mut seed = 12345u64;
         let mut rnd = || {
-            seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            seed = seed
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
             ((seed >> 11) as f64 / (1u64 << 53) as f64) * 2.0 - 1.0
         };
         for n in 1..=5 {
@@ -210,11 +261,15 @@ mod tests {
                 let l = DMatrix::from_fn(n, n, |_, _| rnd());
                 let m = &l * l.transpose();
                 let (vals, vecs) = sym_eigen(n, &to_small(&m));
-                let mut reference: Vec<f64> = m.clone().symmetric_eigen().eigenvalues.iter().copied().collect();
+                let mut reference: Vec<f64> =
+                    m.clone().symmetric_eigen().eigenvalues.iter().copied().collect();
                 reference.sort_by(|a, b| a.total_cmp(b));
                 let norm = m.norm();
                 for k in 0..n {
-                    assert!((vals[k] - reference[k]).abs() <= 1e-13 * norm, "n={n} {vals:?} {reference:?}");
+                    assert!(
+                        (vals[k] - reference[k]).abs() <= 1e-13 * norm,
+                        "n={n} {vals:?} {reference:?}"
+                    );
                     // A v = λ v
                     for i in 0..n {
                         let av: f64 = (0..n).map(|j| m[(i, j)] * vecs[j][k]).sum();

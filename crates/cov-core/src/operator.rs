@@ -205,7 +205,9 @@ impl<const N: usize> Operator<N> for Chain<N> {
     }
 
     fn requires(&self) -> AxisSet {
-        self.steps.iter().fold(AxisSet::FLAT, |s, op| s.union(op.requires()))
+        self.steps
+            .iter()
+            .fold(AxisSet::FLAT, |s, op| s.union(op.requires()))
     }
 }
 

@@ -53,7 +53,10 @@ impl<const N: usize> Cov<N> {
                 m[a][b] = self.get(i, j);
             }
         }
-        Ok(CovBlock { axes: axes.to_vec(), m })
+        Ok(CovBlock {
+            axes: axes.to_vec(),
+            m,
+        })
     }
 
     /// The covariance of the primal integrated over every axis not in `keep` (rule 4:
@@ -64,7 +67,11 @@ impl<const N: usize> Cov<N> {
     /// Missing or repeated axis, or an empty list.
     pub fn integrated(&self, keep: &[Axis]) -> Result<CovBlock, CovError> {
         indices::<N>("integrated", keep)?;
-        let dropped: Vec<Axis> = Self::axes().iter().copied().filter(|a| !keep.contains(a)).collect();
+        let dropped: Vec<Axis> = Self::axes()
+            .iter()
+            .copied()
+            .filter(|a| !keep.contains(a))
+            .collect();
         let mut c = *self;
         if !dropped.is_empty() {
             c.integrate(&dropped)?;
@@ -80,7 +87,10 @@ impl<const N: usize> Cov<N> {
                 *v = self.get(i, j);
             }
         }
-        CovBlock { axes: Self::axes().to_vec(), m }
+        CovBlock {
+            axes: Self::axes().to_vec(),
+            m,
+        }
     }
 }
 
