@@ -12,6 +12,22 @@ use crate::linalg::{MAX, Small, psd_pinv, sym_eigen};
 use crate::{Axis, Cov, CovError, PSD_RTOL};
 
 impl<const N: usize> Cov<N> {
+    /// The (position, direction) axis pairs of this layout: `[(x, u)]` in flatland,
+    /// `[(x, u), (y, v)]` in 3D. Flatland operator definitions apply to each pair.
+    pub fn transverse_pairs() -> &'static [(Axis, Axis)] {
+        if N >= 4 { &[(Axis::X, Axis::U), (Axis::Y, Axis::V)] } else { &[(Axis::X, Axis::U)] }
+    }
+
+    /// The direction axes of this layout: `[u]` or `[u, v]`.
+    pub fn direction_axes() -> &'static [Axis] {
+        if N >= 4 { &[Axis::U, Axis::V] } else { &[Axis::U] }
+    }
+
+    /// The spatial axes of this layout: `[x]` or `[x, y]`.
+    pub fn spatial_axes() -> &'static [Axis] {
+        if N >= 4 { &[Axis::X, Axis::Y] } else { &[Axis::X] }
+    }
+
     /// Rule 1 with a dense matrix: `l'(z) = l(A z)` gives `Σ' = Aᵀ Σ A`.
     ///
     /// # Errors
