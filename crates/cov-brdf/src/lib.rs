@@ -1,0 +1,238 @@
+//! # cov-brdf: reflectance lobes and reflection at a curved surface
+//!
+//! **Primal definition** (PHYSICS.md section 3): a BRDF lobe `ρ` convolves the light field
+//! in angle, `l'(x,u) = ∫ l(x,u') ρ(u − u') du'`. By rule 3, with `S` the spectrum
+//! covariance of `ρ` on the direction axes, `Σ' = Σ − Σ Pᵀ (S + PΣPᵀ)⁻¹ P Σ` (computed by
+//! cov-core without inverting Σ). A Gaussian lobe of variance `var` (tangent units²) has
+//! `S = 1 / (4π² var)`.
+//!
+//! | lobe | parameter | unit | domain | Gaussian variance of the lobe (per axis) |
+//! |---|---|---|---|---|
+//! | [`Lobe::Diffuse`] | – | | | ∞ (`S = 0`: all angular content removed) |
+//! | [`Lobe::Mirror`] | – | | | 0 (identity) |
+//! | [`Lobe::Phong`] | `exponent` | – | ≥ 0 | `1/e` (`cos^e θ ≈ exp(−e θ²/2)`); `e = 0` is diffuse |
+//! | [`Lobe::Gaussian`] | `var_u`, `var_v` | tan² | ≥ 0 | as given (0 = mirror on that axis) |
+//! | [`Lobe::Beckmann`] | `alpha_u`, `alpha_v` | – | ≥ 0 | `2α²`: Beckmann slopes are Gaussian with variance `α²/2`, and a reflected direction turns by twice the slope |
+//! | [`Lobe::Ggx`] | `alpha_u`, `alpha_v` | – | ≥ 0 | `α²`: fit of the curvature at the peak (slope variance `α²/4`, doubled angle); GGX tails are heavy, so this is an approximation whose error the tests measure |
+//!
+//! Zero roughness is the mirror, exactly. Anisotropic roughness is along the frame's
+//! `u` and `v` (rotate the frame first with cov-projection's `RotateFrame`).
+//!
+//! [`Reflect`] is the composite reflection at a curved surface, in order: projection
+//! (`cos_in`), curvature, mirror symmetry, lobe, inverse curvature, inverse projection
+//! (`cos_out`); the frame's `x` must lie in the plane of incidence.
+//!
+//! ```
+//! use cov_brdf::{Lobe, Reflect};
+//! use cov_core::{Cov, Operator};
+//! use cov_curvature::Curvature;
+//!
+//! let mut c = Cov::<2>::gaussian([0.01, 0.05])?;
+//! let r = Reflect::new(0.8, 0.8, Curvature::isotropic(2.0)?, Lobe::phong(100.0)?)?;
+//! Operator::<2>::apply(&r, &mut c)?;
+//! assert!(c.validity().is_valid());
+//! # Ok::<(), cov_core::CovError>(())
+//! ```
+
+#![warn(missing_docs)]
+
+use cov_core::{Cov, CovError, FOUR_PI_SQ, Operator};
+use cov_curvature::Curvature;
+use cov_projection::{Mirror, Project, Unproject};
+
+/// A reflectance (or transmittance) lobe over the outgoing direction.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Lobe {
+    /// Lambertian: removes all angular content.
+    Diffuse,
+    /// Perfect specular: leaves Σ unchanged.
+    Mirror,
+    /// Phong lobe of the given exponent.
+    Phong {
+        /// Exponent `e ≥ 0`.
+        exponent: f64,
+    },
+    /// Gaussian lobe with the given variances (tangent units²) along `u` and `v`.
+    Gaussian {
+        /// Variance along `u`.
+        var_u: f64,
+        /// Variance along `v`.
+        var_v: f64,
+    },
+    /// Beckmann microfacet lobe.
+    Beckmann {
+        /// Roughness along `u`.
+        alpha_u: f64,
+        /// Roughness along `v`.
+        alpha_v: f64,
+    },
+    /// GGX (Trowbridge–Reitz) microfacet lobe, Gaussian fit at the peak.
+    Ggx {
+        /// Roughness along `u`.
+        alpha_u: f64,
+        /// Roughness along `v`.
+        alpha_v: f64,
+    },
+}
+
+impl Lobe {
+    /// A Phong lobe.
+    ///
+    /// # Errors
+    /// Negative or non-finite exponent.
+    pub fn phong(exponent: f64) -> Result<Lobe, CovError> {
+        CovError::check_non_negative("Phong", "exponent", exponent)?;
+        Ok(Lobe::Phong { exponent })
+    }
+
+    /// An isotropic Beckmann lobe.
+    ///
+    /// # Errors
+    /// Negative or non-finite roughness.
+    pub fn beckmann(alpha: f64) -> Result<Lobe, CovError> {
+        Lobe::Beckmann {
+            alpha_u: alpha,
+            alpha_v: alpha,
+        }
+        .validated()
+    }
+
+    /// An isotropic GGX lobe.
+    ///
+    /// # Errors
+    /// Negative or non-finite roughness.
+    pub fn ggx(alpha: f64) -> Result<Lobe, CovError> {
+        Lobe::Ggx {
+            alpha_u: alpha,
+            alpha_v: alpha,
+        }
+        .validated()
+    }
+
+    /// Checks the parameters (for lobes built as enum literals).
+    ///
+    /// # Errors
+    /// Negative or non-finite parameters.
+    pub fn validated(self) -> Result<Lobe, CovError> {
+        let (name, a, b) = match self {
+            Lobe::Diffuse | Lobe::Mirror => return Ok(self),
+            Lobe::Phong { exponent } => ("Phong", exponent, 0.0),
+            Lobe::Gaussian { var_u, var_v } => ("Gaussian", var_u, var_v),
+            Lobe::Beckmann { alpha_u, alpha_v } => ("Beckmann", alpha_u, alpha_v),
+            Lobe::Ggx { alpha_u, alpha_v } => ("Ggx", alpha_u, alpha_v),
+        };
+        CovError::check_non_negative(name, "first parameter", a)?;
+        CovError::check_non_negative(name, "second parameter", b)?;
+        Ok(self)
+    }
+
+    /// Primal variance of the lobe along `u` and `v` (tangent units²): 0 for a mirror,
+    /// infinite for diffuse.
+    pub fn variances(&self) -> (f64, f64) {
+        match *self {
+            Lobe::Diffuse => (f64::INFINITY, f64::INFINITY),
+            Lobe::Mirror => (0.0, 0.0),
+            Lobe::Phong { exponent } => {
+                let v = if exponent == 0.0 { f64::INFINITY } else { 1.0 / exponent };
+                (v, v)
+            }
+            Lobe::Gaussian { var_u, var_v } => (var_u, var_v),
+            Lobe::Beckmann { alpha_u, alpha_v } => (2.0 * alpha_u * alpha_u, 2.0 * alpha_v * alpha_v),
+            Lobe::Ggx { alpha_u, alpha_v } => (alpha_u * alpha_u, alpha_v * alpha_v),
+        }
+    }
+
+    /// Applies the lobe on the direction axes (rule 3). Axes with a zero variance (mirror)
+    /// are skipped; an infinite variance (diffuse) uses `S = 0`.
+    ///
+    /// # Errors
+    /// Overflow.
+    pub fn apply_to<const N: usize>(&self, cov: &mut Cov<N>) -> Result<(), CovError> {
+        let (vu, vv) = self.variances();
+        let dirs = Cov::<N>::direction_axes();
+        for (&axis, var) in dirs.iter().zip([vu, vv]) {
+            if var == 0.0 {
+                continue;
+            }
+            // S = 1/(4π² var): 0 for a diffuse lobe; a tiny var gives a large finite S.
+            let s = 1.0 / (FOUR_PI_SQ * var);
+            let s = if s.is_finite() { s } else { f64::MAX };
+            cov.convolve(&[axis], &[s])?;
+        }
+        Ok(())
+    }
+}
+
+/// A lobe applied on its own (e.g. a phase function or a rough transmission).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Brdf {
+    lobe: Lobe,
+}
+
+impl Brdf {
+    /// Operator name.
+    pub const NAME: &'static str = "Brdf";
+
+    /// # Errors
+    /// Invalid lobe parameters.
+    pub fn new(lobe: Lobe) -> Result<Self, CovError> {
+        Ok(Brdf { lobe: lobe.validated()? })
+    }
+
+    /// The lobe.
+    pub fn lobe(&self) -> Lobe {
+        self.lobe
+    }
+}
+
+impl<const N: usize> Operator<N> for Brdf {
+    fn apply(&self, cov: &mut Cov<N>) -> Result<(), CovError> {
+        self.lobe.apply_to(cov)
+    }
+    fn name(&self) -> &str {
+        Self::NAME
+    }
+}
+
+/// Reflection at a curved surface: projection, curvature, mirror symmetry, lobe, inverse
+/// curvature, inverse projection to the outgoing direction.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Reflect {
+    project: Project,
+    curvature: Curvature,
+    lobe: Lobe,
+    unproject: Unproject,
+}
+
+impl Reflect {
+    /// Operator name.
+    pub const NAME: &'static str = "Reflect";
+
+    /// # Errors
+    /// `cos_in`, `cos_out` not in (0, 1]; invalid lobe.
+    pub fn new(cos_in: f64, cos_out: f64, curvature: Curvature, lobe: Lobe) -> Result<Self, CovError> {
+        Ok(Reflect {
+            project: Project::new(cos_in)?,
+            curvature,
+            lobe: lobe.validated()?,
+            unproject: Unproject::new(cos_out)?,
+        })
+    }
+}
+
+impl<const N: usize> Operator<N> for Reflect {
+    fn apply(&self, cov: &mut Cov<N>) -> Result<(), CovError> {
+        Operator::<N>::apply(&self.project, cov)?;
+        Operator::<N>::apply(&self.curvature, cov)?;
+        Operator::<N>::apply(&Mirror, cov)?;
+        self.lobe.apply_to(cov)?;
+        Operator::<N>::apply(&self.curvature.inverse(), cov)?;
+        Operator::<N>::apply(&self.unproject, cov)
+    }
+    fn name(&self) -> &str {
+        Self::NAME
+    }
+    fn requires(&self) -> cov_core::AxisSet {
+        Operator::<5>::requires(&self.curvature)
+    }
+}

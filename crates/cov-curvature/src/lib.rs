@@ -1,0 +1,163 @@
+//! # cov-curvature: curved surfaces
+//!
+//! **Primal definition** (PHYSICS.md section 3), in the surface frame after projection:
+//! `l'(x,u) = l(x, u + k·x)`. In 3D a surface has a curvature tensor `K` (symmetric
+//! 2×2, 1/m) and `(u,v) ← (u,v) + K (x,y)`; with principal curvatures `kx ≠ ky` along a
+//! principal direction at angle `α` from the frame's `x`, `K = R(α) diag(kx, ky) R(α)ᵀ`.
+//!
+//! **Sign**: `k > 0` for a convex surface seen from the side the light arrives on (a
+//! sphere of radius `R` seen from outside: `k = 1/R`), as fixed in cov-core. Checked
+//! against ray tracing: a convex mirror (curvature, mirror symmetry, inverse curvature)
+//! turns parallel rays at offset `x` by `2x/R` away from the axis.
+//!
+//! | operator | parameter | unit | domain | meaning |
+//! |---|---|---|---|---|
+//! | [`Curvature`] | `kx` | 1/m | finite | principal curvature along the principal direction |
+//! | [`Curvature`] | `ky` | 1/m | finite | the other principal curvature (3D) |
+//! | [`Curvature`] | `angle` | rad | finite | angle from the frame's `x` to the first principal direction (3D) |
+//! | [`CurvatureTensor`] | `kxx`, `kxy`, `kyy` | 1/m | finite | the tensor `K` in the frame (the dense form) |
+//!
+//! An anisotropic curvature (`kx ≠ ky` or `angle ≠ 0`) needs the 3D layout; an isotropic
+//! one works in every layout.
+//!
+//! ```
+//! use cov_core::{Cov, Operator};
+//! use cov_curvature::Curvature;
+//!
+//! let mut c = Cov::<4>::gaussian([0.01, 0.01, f64::INFINITY, f64::INFINITY])?;
+//! Operator::<4>::apply(&Curvature::anisotropic(2.0, -0.5, 0.3)?, &mut c)?;
+//! assert!(c.validity().is_valid());
+//! # Ok::<(), cov_core::CovError>(())
+//! ```
+
+#![warn(missing_docs)]
+
+use cov_core::{Axis, AxisSet, Cov, CovError, Operator};
+
+/// Curvature by principal curvatures and direction.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Curvature {
+    kx: f64,
+    ky: f64,
+    angle: f64,
+}
+
+impl Curvature {
+    /// Operator name.
+    pub const NAME: &'static str = "Curvature";
+
+    /// The same curvature `k` (1/m) in every direction.
+    ///
+    /// # Errors
+    /// Non-finite `k`.
+    pub fn isotropic(k: f64) -> Result<Self, CovError> {
+        Self::anisotropic(k, k, 0.0)
+    }
+
+    /// Principal curvatures `kx` along the direction at `angle` (rad) from the frame's `x`,
+    /// and `ky` across it.
+    ///
+    /// # Errors
+    /// Non-finite parameters.
+    pub fn anisotropic(kx: f64, ky: f64, angle: f64) -> Result<Self, CovError> {
+        Ok(Curvature {
+            kx: CovError::check_finite(Self::NAME, "kx", kx)?,
+            ky: CovError::check_finite(Self::NAME, "ky", ky)?,
+            angle: CovError::check_finite(Self::NAME, "angle", angle)?,
+        })
+    }
+
+    /// The same curvature with opposite sign (used to leave the surface frame).
+    pub fn inverse(&self) -> Self {
+        Curvature {
+            kx: -self.kx,
+            ky: -self.ky,
+            angle: self.angle,
+        }
+    }
+
+    /// The tensor `K = R(α) diag(kx, ky) R(α)ᵀ` in the frame: `(kxx, kxy, kyy)`.
+    pub fn tensor(&self) -> (f64, f64, f64) {
+        let (s, c) = self.angle.sin_cos();
+        (
+            c * c * self.kx + s * s * self.ky,
+            c * s * (self.kx - self.ky),
+            s * s * self.kx + c * c * self.ky,
+        )
+    }
+
+    fn is_isotropic(&self) -> bool {
+        self.kx == self.ky
+    }
+}
+
+impl<const N: usize> Operator<N> for Curvature {
+    fn apply(&self, cov: &mut Cov<N>) -> Result<(), CovError> {
+        if self.is_isotropic() {
+            for &(p, d) in Cov::<N>::transverse_pairs() {
+                cov.shear(d, p, self.kx)?;
+            }
+            return Ok(());
+        }
+        // Principal frame: rotate, shear each pair by its curvature, rotate back.
+        cov.rotate_frame(self.angle)?;
+        cov.shear(Axis::U, Axis::X, self.kx)?;
+        cov.shear(Axis::V, Axis::Y, self.ky)?;
+        cov.rotate_frame(-self.angle)
+    }
+    fn name(&self) -> &str {
+        Self::NAME
+    }
+    fn requires(&self) -> AxisSet {
+        if self.is_isotropic() { AxisSet::FLAT } else { AxisSet::SPACE }
+    }
+}
+
+/// Curvature given by its tensor in the frame. Flatland uses `kxx` and needs
+/// `kxy = kyy = 0`; otherwise the 3D layout.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct CurvatureTensor {
+    k: [f64; 3],
+}
+
+impl CurvatureTensor {
+    /// Operator name.
+    pub const NAME: &'static str = "CurvatureTensor";
+
+    /// # Errors
+    /// Non-finite entries.
+    pub fn new(kxx: f64, kxy: f64, kyy: f64) -> Result<Self, CovError> {
+        Ok(CurvatureTensor {
+            k: [
+                CovError::check_finite(Self::NAME, "kxx", kxx)?,
+                CovError::check_finite(Self::NAME, "kxy", kxy)?,
+                CovError::check_finite(Self::NAME, "kyy", kyy)?,
+            ],
+        })
+    }
+}
+
+impl<const N: usize> Operator<N> for CurvatureTensor {
+    fn apply(&self, cov: &mut Cov<N>) -> Result<(), CovError> {
+        let [kxx, kxy, kyy] = self.k;
+        cov.shear(Axis::U, Axis::X, kxx)?;
+        if Cov::<N>::has(Axis::Y) {
+            // The four shears commute: each adds position to direction.
+            cov.shear(Axis::U, Axis::Y, kxy)?;
+            cov.shear(Axis::V, Axis::X, kxy)?;
+            cov.shear(Axis::V, Axis::Y, kyy)?;
+        } else if kxy != 0.0 || kyy != 0.0 {
+            return Err(CovError::MissingAxis {
+                axis: Axis::Y,
+                layout: N,
+            });
+        }
+        Ok(())
+    }
+    fn name(&self) -> &str {
+        Self::NAME
+    }
+    fn requires(&self) -> AxisSet {
+        if self.k[1] != 0.0 || self.k[2] != 0.0 { AxisSet::SPACE } else { AxisSet::FLAT }
+    }
+}

@@ -1,0 +1,238 @@
+//! # cov-projection: from the ray to the surface and back
+//!
+//! **Primal definitions** (PHYSICS.md section 3), with `c = |cos θ|` and the frame's `x`
+//! axis in the plane of incidence:
+//!
+//! - projection, ray → surface: `l'(x,u) = l(c·x, u)` ([`Project`]);
+//! - inverse projection, surface → outgoing ray: `l'(x,u) = l(x / c_out, u)` ([`Unproject`]);
+//! - mirror symmetry (reflection): `l'(x,u) = l(x, −u)` on every direction axis ([`Mirror`]);
+//! - rotation of the tangent frame by `α` (3D): `(x,y)` and `(u,v)` turn together
+//!   ([`RotateFrame`]; positive is counter-clockwise from `x` to `y`).
+//!
+//! Foreshortening lowers spatial frequencies on the surface by `c`: `Σ_xx' = c² Σ_xx`.
+//! Grazing incidence (`c → 0`) is a limit, not an error, as long as `c > 0`: the result
+//! stays finite and PSD (`c = 1e-12` is part of the tests).
+//!
+//! | operator | parameter | unit | domain | meaning |
+//! |---|---|---|---|---|
+//! | [`Project`] | `cos` | – | (0, 1] | `|cos θ|` between the ray and the normal |
+//! | [`Project`] | `angle` | rad | finite | frame rotation applied first, aligning `x` with the plane of incidence (3D; must be 0 in flatland) |
+//! | [`Unproject`] | `cos` | – | (0, 1] | `|cos θ_out|` of the outgoing ray |
+//! | [`Unproject`] | `angle` | rad | finite | frame rotation applied last (3D; 0 in flatland) |
+//! | [`Mirror`] | – | | | |
+//! | [`RotateFrame`] | `angle` | rad | finite | |
+//!
+//! [`Project::from_vectors`] computes `cos` and `angle` from the ray direction, the
+//! ray frame's `x` axis and the surface normal (glam `DVec3`).
+//!
+//! ```
+//! use cov_core::{Cov, Operator};
+//! use cov_projection::{Project, Unproject};
+//!
+//! let mut c = Cov::<2>::gaussian([0.01, 0.1])?;
+//! let before = c.get(0, 0);
+//! Operator::<2>::apply(&Project::new(0.5)?, &mut c)?;
+//! assert!((c.get(0, 0) - 0.25 * before).abs() < 1e-12 * before);
+//! Operator::<2>::apply(&Unproject::new(0.5)?, &mut c)?; // back to the same angle
+//! assert!((c.get(0, 0) - before).abs() < 1e-12 * before);
+//! # Ok::<(), cov_core::CovError>(())
+//! ```
+
+#![warn(missing_docs)]
+
+use cov_core::{Axis, AxisSet, Cov, CovError, Operator};
+use glam::DVec3;
+
+fn check_cos(op: &str, c: f64) -> Result<f64, CovError> {
+    CovError::check_range(op, "cos", c, |c| c > 0.0 && c <= 1.0, "must be in (0, 1]")
+}
+
+fn rotate<const N: usize>(cov: &mut Cov<N>, angle: f64) -> Result<(), CovError> {
+    if angle != 0.0 { cov.rotate_frame(angle) } else { Ok(()) }
+}
+
+fn needs(angle: f64) -> AxisSet {
+    if angle != 0.0 { AxisSet::SPACE } else { AxisSet::FLAT }
+}
+
+/// Projection from the ray's transverse plane onto the surface.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Project {
+    cos: f64,
+    angle: f64,
+}
+
+impl Project {
+    /// Operator name.
+    pub const NAME: &'static str = "Project";
+
+    /// Projection with `|cos θ| = cos`, frame already aligned.
+    ///
+    /// # Errors
+    /// `cos` not in (0, 1].
+    pub fn new(cos: f64) -> Result<Self, CovError> {
+        Self::with_angle(cos, 0.0)
+    }
+
+    /// Rotate the frame by `angle` (rad) first, then project.
+    ///
+    /// # Errors
+    /// `cos` not in (0, 1], non-finite `angle`.
+    pub fn with_angle(cos: f64, angle: f64) -> Result<Self, CovError> {
+        Ok(Project {
+            cos: check_cos(Self::NAME, cos)?,
+            angle: CovError::check_finite(Self::NAME, "angle", angle)?,
+        })
+    }
+
+    /// From geometry: the ray direction `dir`, the ray frame's `x` axis `frame_x` (both
+    /// unit, orthogonal; the frame's `y` is `dir × frame_x`) and the surface normal. The
+    /// angle turns `x` into the plane of incidence; at normal incidence it is 0.
+    ///
+    /// # Errors
+    /// Non-unit or non-orthogonal inputs (tolerance 1e-9), non-finite components, or a
+    /// ray parallel to the surface (`cos = 0`).
+    pub fn from_vectors(dir: DVec3, frame_x: DVec3, normal: DVec3) -> Result<Self, CovError> {
+        for (name, v) in [("dir", dir), ("frame_x", frame_x), ("normal", normal)] {
+            if !v.is_finite() || (v.length() - 1.0).abs() > 1e-9 {
+                return Err(CovError::OutOfRange {
+                    operator: Self::NAME.into(),
+                    parameter: name.into(),
+                    value: v.length(),
+                    expected: "a finite unit vector".into(),
+                });
+            }
+        }
+        if dir.dot(frame_x).abs() > 1e-9 {
+            return Err(CovError::OutOfRange {
+                operator: Self::NAME.into(),
+                parameter: "frame_x".into(),
+                value: dir.dot(frame_x),
+                expected: "orthogonal to dir".into(),
+            });
+        }
+        let cos = dir.dot(normal).abs();
+        let frame_y = dir.cross(frame_x);
+        let p = normal - normal.dot(dir) * dir;
+        // At (near-)normal incidence every transverse axis is in the plane of incidence.
+        let angle = if p.length() <= 1e-12 { 0.0 } else { p.dot(frame_y).atan2(p.dot(frame_x)) };
+        Self::with_angle(cos, angle)
+    }
+
+    /// `|cos θ|`.
+    pub fn cos(&self) -> f64 {
+        self.cos
+    }
+
+    /// Frame rotation (rad).
+    pub fn angle(&self) -> f64 {
+        self.angle
+    }
+}
+
+impl<const N: usize> Operator<N> for Project {
+    fn apply(&self, cov: &mut Cov<N>) -> Result<(), CovError> {
+        rotate(cov, self.angle)?;
+        cov.scale(Axis::X, self.cos)
+    }
+    fn name(&self) -> &str {
+        Self::NAME
+    }
+    fn requires(&self) -> AxisSet {
+        needs(self.angle)
+    }
+}
+
+/// Inverse projection from the surface to the outgoing ray.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Unproject {
+    cos: f64,
+    angle: f64,
+}
+
+impl Unproject {
+    /// Operator name.
+    pub const NAME: &'static str = "Unproject";
+
+    /// # Errors
+    /// `cos` not in (0, 1].
+    pub fn new(cos: f64) -> Result<Self, CovError> {
+        Self::with_angle(cos, 0.0)
+    }
+
+    /// Unproject, then rotate the frame by `angle` (rad).
+    ///
+    /// # Errors
+    /// `cos` not in (0, 1], non-finite `angle`.
+    pub fn with_angle(cos: f64, angle: f64) -> Result<Self, CovError> {
+        Ok(Unproject {
+            cos: check_cos(Self::NAME, cos)?,
+            angle: CovError::check_finite(Self::NAME, "angle", angle)?,
+        })
+    }
+}
+
+impl<const N: usize> Operator<N> for Unproject {
+    fn apply(&self, cov: &mut Cov<N>) -> Result<(), CovError> {
+        cov.scale(Axis::X, 1.0 / self.cos)?;
+        rotate(cov, self.angle)
+    }
+    fn name(&self) -> &str {
+        Self::NAME
+    }
+    fn requires(&self) -> AxisSet {
+        needs(self.angle)
+    }
+}
+
+/// Mirror symmetry: `l'(x,u) = l(x, −u)` (and `v` in 3D).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Mirror;
+
+impl Mirror {
+    /// Operator name.
+    pub const NAME: &'static str = "Mirror";
+}
+
+impl<const N: usize> Operator<N> for Mirror {
+    fn apply(&self, cov: &mut Cov<N>) -> Result<(), CovError> {
+        for &a in Cov::<N>::direction_axes() {
+            cov.scale(a, -1.0)?;
+        }
+        Ok(())
+    }
+    fn name(&self) -> &str {
+        Self::NAME
+    }
+}
+
+/// Rotation of the tangent frame by `angle` (rad), `(x,y)` and `(u,v)` together.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct RotateFrame {
+    angle: f64,
+}
+
+impl RotateFrame {
+    /// Operator name.
+    pub const NAME: &'static str = "RotateFrame";
+
+    /// # Errors
+    /// Non-finite `angle`.
+    pub fn new(angle: f64) -> Result<Self, CovError> {
+        Ok(RotateFrame {
+            angle: CovError::check_finite(Self::NAME, "angle", angle)?,
+        })
+    }
+}
+
+impl<const N: usize> Operator<N> for RotateFrame {
+    fn apply(&self, cov: &mut Cov<N>) -> Result<(), CovError> {
+        cov.rotate_frame(self.angle)
+    }
+    fn name(&self) -> &str {
+        Self::NAME
+    }
+    fn requires(&self) -> AxisSet {
+        AxisSet::SPACE
+    }
+}

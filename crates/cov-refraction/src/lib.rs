@@ -1,0 +1,136 @@
+//! # cov-refraction: Snell interfaces, smooth and rough
+//!
+//! **Primal definition** (PHYSICS.md section 3), frame `x` in the plane of incidence:
+//! spatially, a projection with `cos_i` then an inverse projection with `cos_t`, i.e.
+//! `l'(x,u) = l(x·cos_i/cos_t, u)`; in angle, `u_t = a·u_i` with
+//! `a = n1 cos_i / (n2 cos_t)`, i.e. `l'(x,u) = l(x, u/a)`.
+//!
+//! In 3D the axis across the plane of incidence (`y`, `v`) is not foreshortened, and its
+//! angle scales by `n1/n2` (the tangential part of the direction scales by `n1/n2`, vector
+//! Snell). Both facts are checked against a ray-traced Jacobian of vector Snell's law.
+//!
+//! Total internal reflection transmits nothing: [`Refract::new`] returns
+//! [`CovError::NoTransport`], never NaN. Near the critical angle `cos_t → 0` and the
+//! angular scale `a` grows without bound; it stays finite while `cos_t > 0`.
+//!
+//! | operator | parameter | unit | domain | meaning |
+//! |---|---|---|---|---|
+//! | [`Refract`] | `n1`, `n2` | – | > 0 | refractive indices before and after the interface |
+//! | [`Refract`] | `cos_i` | – | (0, 1] | `|cos|` of the incident angle to the normal |
+//! | [`RoughRefract`] | `refract`, `lobe` | | | a [`Refract`] followed by a transmission lobe (cov-brdf's [`Lobe`]) on the transmitted side |
+//!
+//! ```
+//! use cov_core::{Cov, Operator};
+//! use cov_refraction::Refract;
+//!
+//! let glass = Refract::new(1.0, 1.5, 0.9)?;
+//! let mut c = Cov::<2>::gaussian([0.01, 0.1])?;
+//! Operator::<2>::apply(&glass, &mut c)?;
+//! // Entering glass narrows the angular spread: angular frequencies go up.
+//! assert!(c.get(1, 1) > Cov::<2>::gaussian([0.01, 0.1])?.get(1, 1));
+//! // Leaving glass at a grazing angle: total internal reflection is an error.
+//! assert!(Refract::new(1.5, 1.0, 0.3).is_err());
+//! # Ok::<(), cov_core::CovError>(())
+//! ```
+
+#![warn(missing_docs)]
+
+use cov_brdf::Lobe;
+use cov_core::{Axis, Cov, CovError, Operator};
+
+/// A smooth interface between media of indices `n1` (incident side) and `n2`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Refract {
+    n1: f64,
+    n2: f64,
+    cos_i: f64,
+    cos_t: f64,
+}
+
+impl Refract {
+    /// Operator name.
+    pub const NAME: &'static str = "Refract";
+
+    /// # Errors
+    /// Non-positive or non-finite indices, `cos_i` not in (0, 1], or total internal
+    /// reflection ([`CovError::NoTransport`]).
+    pub fn new(n1: f64, n2: f64, cos_i: f64) -> Result<Self, CovError> {
+        CovError::check_positive(Self::NAME, "n1", n1)?;
+        CovError::check_positive(Self::NAME, "n2", n2)?;
+        CovError::check_range(Self::NAME, "cos_i", cos_i, |c| c > 0.0 && c <= 1.0, "must be in (0, 1]")?;
+        let eta = n1 / n2;
+        // sin²θ_i = (1 − cos)(1 + cos): no cancellation near normal incidence.
+        let sin2_i = (1.0 - cos_i) * (1.0 + cos_i);
+        let cos2_t = 1.0 - eta * eta * sin2_i;
+        if cos2_t <= 0.0 {
+            return Err(CovError::NoTransport {
+                operator: Self::NAME.into(),
+                reason: format!(
+                    "total internal reflection: n1/n2 = {eta} and cos_i = {cos_i} give sin θ_t = {} ≥ 1",
+                    eta * sin2_i.sqrt()
+                ),
+            });
+        }
+        Ok(Refract {
+            n1,
+            n2,
+            cos_i,
+            cos_t: cos2_t.sqrt(),
+        })
+    }
+
+    /// `|cos θ_t|` of the transmitted ray.
+    pub fn cos_t(&self) -> f64 {
+        self.cos_t
+    }
+
+    /// The angular scale in the plane of incidence, `a = n1 cos_i / (n2 cos_t)`.
+    pub fn angular_scale(&self) -> f64 {
+        self.n1 * self.cos_i / (self.n2 * self.cos_t)
+    }
+}
+
+impl<const N: usize> Operator<N> for Refract {
+    fn apply(&self, cov: &mut Cov<N>) -> Result<(), CovError> {
+        cov.scale(Axis::X, self.cos_i / self.cos_t)?;
+        cov.scale(Axis::U, 1.0 / self.angular_scale())?;
+        if Cov::<N>::has(Axis::V) {
+            cov.scale(Axis::V, self.n2 / self.n1)?;
+        }
+        Ok(())
+    }
+    fn name(&self) -> &str {
+        Self::NAME
+    }
+}
+
+/// A rough interface: refraction then a lobe on the transmitted side.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct RoughRefract {
+    refract: Refract,
+    lobe: Lobe,
+}
+
+impl RoughRefract {
+    /// Operator name.
+    pub const NAME: &'static str = "RoughRefract";
+
+    /// # Errors
+    /// As [`Refract::new`], or invalid lobe parameters.
+    pub fn new(n1: f64, n2: f64, cos_i: f64, lobe: Lobe) -> Result<Self, CovError> {
+        Ok(RoughRefract {
+            refract: Refract::new(n1, n2, cos_i)?,
+            lobe: lobe.validated()?,
+        })
+    }
+}
+
+impl<const N: usize> Operator<N> for RoughRefract {
+    fn apply(&self, cov: &mut Cov<N>) -> Result<(), CovError> {
+        Operator::<N>::apply(&self.refract, cov)?;
+        self.lobe.apply_to(cov)
+    }
+    fn name(&self) -> &str {
+        Self::NAME
+    }
+}

@@ -1,0 +1,65 @@
+//! # cov-travel: free-space travel
+//!
+//! **Primal definition** (PHYSICS.md section 3): travel by a distance `d` along the ray
+//! shears position by direction, `l'(x,u) = l(x − d·u, u)`, and `(y, v)` likewise in 3D.
+//! Time is unchanged (light is instantaneous at scene scales).
+//!
+//! **Spectrum**: rule 1 with `A = [[1, −d], [0, 1]]`, i.e. `Σ_uu += −2d Σ_xu + d² Σ_xx`
+//! and `Σ_xu −= d Σ_xx`: spatial frequencies leak into angle as light travels.
+//!
+//! | parameter | unit | domain | meaning |
+//! |---|---|---|---|
+//! | `distance` | m | finite (negative travels back) | length travelled along the ray |
+//!
+//! Layouts: all (N = 2, 3, 4, 5); needs `x, u`.
+//!
+//! ```
+//! use cov_core::{Cov, Operator};
+//! use cov_travel::Travel;
+//!
+//! let mut c = Cov::<2>::gaussian([0.01, f64::INFINITY])?; // a 1 cm spot, diffuse emitter
+//! Operator::<2>::apply(&Travel::new(2.0)?, &mut c)?;
+//! // Σ_uu = d² Σ_xx: the spot's spatial content now shows in angle.
+//! assert!((c.get(1, 1) - 4.0 * c.get(0, 0)).abs() < 1e-9 * c.get(1, 1));
+//! # Ok::<(), cov_core::CovError>(())
+//! ```
+
+#![warn(missing_docs)]
+
+use cov_core::{Cov, CovError, Operator};
+
+/// Travel by `distance` metres along the ray.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Travel {
+    distance: f64,
+}
+
+impl Travel {
+    /// Operator name used in tables, errors and RON files.
+    pub const NAME: &'static str = "Travel";
+
+    /// # Errors
+    /// [`CovError::NonFinite`] if `distance` is NaN or infinite.
+    pub fn new(distance: f64) -> Result<Self, CovError> {
+        CovError::check_finite(Self::NAME, "distance", distance)?;
+        Ok(Travel { distance })
+    }
+
+    /// The distance (m).
+    pub fn distance(&self) -> f64 {
+        self.distance
+    }
+}
+
+impl<const N: usize> Operator<N> for Travel {
+    fn apply(&self, cov: &mut Cov<N>) -> Result<(), CovError> {
+        for &(p, d) in Cov::<N>::transverse_pairs() {
+            cov.shear(p, d, -self.distance)?;
+        }
+        Ok(())
+    }
+
+    fn name(&self) -> &str {
+        Self::NAME
+    }
+}
