@@ -22,6 +22,18 @@
 //! (`cos_in`), curvature, mirror symmetry, lobe, inverse curvature, inverse projection
 //! (`cos_out`); the frame's `x` must lie in the plane of incidence.
 //!
+//! **Surface frame convention.** Rays carry `u` in the direction of propagation (travel is
+//! `l(x − d·u, u)`). In the surface frame, incident light is indexed by the direction it
+//! comes from, pointing away from the surface like a BRDF's `ω_i`; entering that frame is
+//! therefore one more symmetry `u → −u` before the curvature. Without it a flat mirror
+//! would flip the sign of `Σ_xu` (turn a converging beam into a diverging one). With it,
+//! the composite reproduces ray-traced reflection off curved mirrors, including
+//! anisotropic ones, to finite-difference accuracy (`tests/geometry.rs`): a ray at offset
+//! `x` on a mirror of curvature `k` turns by `2kx` (`k > 0` convex: diverging). At
+//! oblique incidence the curvature across the plane of incidence is seen scaled by
+//! `cos θ` (cov-curvature's `Curvature::apply_oblique`), which gives the tangential and
+//! sagittal focal lengths `R cos θ / 2` and `R / (2 cos θ)`.
+//!
 //! ```
 //! use cov_brdf::{Lobe, Reflect};
 //! use cov_core::{Cov, Operator};
@@ -223,10 +235,12 @@ impl Reflect {
 impl<const N: usize> Operator<N> for Reflect {
     fn apply(&self, cov: &mut Cov<N>) -> Result<(), CovError> {
         Operator::<N>::apply(&self.project, cov)?;
-        Operator::<N>::apply(&self.curvature, cov)?;
+        // Incident directions in the surface frame point back toward the light.
+        Operator::<N>::apply(&Mirror, cov)?;
+        self.curvature.apply_oblique(cov, self.project.cos(), 1.0)?;
         Operator::<N>::apply(&Mirror, cov)?;
         self.lobe.apply_to(cov)?;
-        Operator::<N>::apply(&self.curvature.inverse(), cov)?;
+        self.curvature.apply_oblique(cov, self.unproject.cos(), -1.0)?;
         Operator::<N>::apply(&self.unproject, cov)
     }
     fn name(&self) -> &str {

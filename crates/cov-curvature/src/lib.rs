@@ -86,6 +86,35 @@ impl Curvature {
         )
     }
 
+    /// Applies the curvature as seen by a ray at `|cos θ| = cos` to the normal, in the
+    /// surface frame with the frame's `x` in the plane of incidence, with directions in
+    /// ray-angle units, scaled by `sign` (+1 entering the surface frame, −1 leaving it).
+    ///
+    /// A normal tilt `δ` in the plane of incidence turns a ray by `δ`, but a tilt across
+    /// the plane turns it by `cos θ·δ`, so the `v` row of the tensor is scaled by `cos θ`:
+    /// `(u, v) ← (u, v) + sign · diag(1, cos θ) K (x, y)`. This reproduces the tangential
+    /// and sagittal focal lengths of a curved mirror (`R cos θ / 2`, `R / (2 cos θ)`). At
+    /// normal incidence it is the operator itself; in flatland `cos` plays no role.
+    ///
+    /// # Errors
+    /// `cos` not in (0, 1], `sign` not finite, overflow.
+    pub fn apply_oblique<const N: usize>(&self, cov: &mut Cov<N>, cos: f64, sign: f64) -> Result<(), CovError> {
+        CovError::check_range(Self::NAME, "cos", cos, |c| c > 0.0 && c <= 1.0, "must be in (0, 1]")?;
+        CovError::check_finite(Self::NAME, "sign", sign)?;
+        let (kxx, kxy, kyy) = self.tensor();
+        if !Cov::<N>::has(Axis::Y) {
+            if !self.is_isotropic() {
+                return Err(CovError::MissingAxis { axis: Axis::Y, layout: N });
+            }
+            return cov.shear(Axis::U, Axis::X, sign * kxx);
+        }
+        // The four shears commute: each adds position to direction.
+        cov.shear(Axis::U, Axis::X, sign * kxx)?;
+        cov.shear(Axis::U, Axis::Y, sign * kxy)?;
+        cov.shear(Axis::V, Axis::X, sign * cos * kxy)?;
+        cov.shear(Axis::V, Axis::Y, sign * cos * kyy)
+    }
+
     fn is_isotropic(&self) -> bool {
         self.kx == self.ky
     }

@@ -154,6 +154,11 @@ impl Unproject {
     /// Operator name.
     pub const NAME: &'static str = "Unproject";
 
+    /// `|cos θ_out|`.
+    pub fn cos(&self) -> f64 {
+        self.cos
+    }
+
     /// # Errors
     /// `cos` not in (0, 1].
     pub fn new(cos: f64) -> Result<Self, CovError> {
