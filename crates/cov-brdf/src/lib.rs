@@ -145,7 +145,11 @@ impl Lobe {
             Lobe::Diffuse => (f64::INFINITY, f64::INFINITY),
             Lobe::Mirror => (0.0, 0.0),
             Lobe::Phong { exponent } => {
-                let v = if exponent == 0.0 { f64::INFINITY } else { 1.0 / exponent };
+                let v = if exponent == 0.0 {
+                    f64::INFINITY
+                } else {
+                    1.0 / exponent
+                };
                 (v, v)
             }
             Lobe::Gaussian { var_u, var_v } => (var_u, var_v),
@@ -188,7 +192,9 @@ impl Brdf {
     /// # Errors
     /// Invalid lobe parameters.
     pub fn new(lobe: Lobe) -> Result<Self, CovError> {
-        Ok(Brdf { lobe: lobe.validated()? })
+        Ok(Brdf {
+            lobe: lobe.validated()?,
+        })
     }
 
     /// The lobe.

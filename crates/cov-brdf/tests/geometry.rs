@@ -55,7 +55,12 @@ fn trace(q: &Quadric, fin: &Frame, fout: &Frame, z: &[f64; 4]) -> [f64; 4] {
     let r = dir - n * (2.0 * dir.dot(&n));
     let s = -h.dot(&fout.d) / r.dot(&fout.d);
     let p = h + r * s;
-    [p.dot(&fout.ex), p.dot(&fout.ey), r.dot(&fout.ex) / r.dot(&fout.d), r.dot(&fout.ey) / r.dot(&fout.d)]
+    [
+        p.dot(&fout.ex),
+        p.dot(&fout.ey),
+        r.dot(&fout.ex) / r.dot(&fout.d),
+        r.dot(&fout.ey) / r.dot(&fout.d),
+    ]
 }
 
 fn jacobian(q: &Quadric, fin: &Frame, fout: &Frame) -> DMatrix<f64> {
@@ -94,29 +99,64 @@ fn check(q: &Quadric, theta: f64, curvature: Curvature) {
     let j = jacobian(q, &fin, &fout);
     let a = j.clone().try_inverse().unwrap();
     let m = SMatrix::<f64, 4, 4>::from_fn(|i, k| {
-        let base = [[4.0, 1.0, 0.5, 0.2], [1.0, 3.0, 0.1, 0.3], [0.5, 0.1, 2.0, 0.4], [0.2, 0.3, 0.4, 1.5]];
+        let base = [
+            [4.0, 1.0, 0.5, 0.2],
+            [1.0, 3.0, 0.1, 0.3],
+            [0.5, 0.1, 2.0, 0.4],
+            [0.2, 0.3, 0.4, 1.5],
+        ];
         base[i][k]
     });
     let start = Cov::<4>::from_matrix(&m).unwrap();
     let expected = a.transpose() * DMatrix::from_fn(4, 4, |i, k| m[(i, k)]) * &a;
     let mut got = start;
     let cos = theta.cos();
-    Operator::<4>::apply(&Reflect::new(cos, cos, curvature, Lobe::Mirror).unwrap(), &mut got).unwrap();
+    Operator::<4>::apply(
+        &Reflect::new(cos, cos, curvature, Lobe::Mirror).unwrap(),
+        &mut got,
+    )
+    .unwrap();
     let got = DMatrix::from_fn(4, 4, |i, k| got.get(i, k));
     let err = (&got - &expected).norm() / expected.norm();
-    assert!(err < 1e-6, "θ={theta}, K=({},{},{}): rel error {err:e}\ngot {got}\nexpected {expected}", q.a, q.b, q.c);
+    assert!(
+        err < 1e-6,
+        "θ={theta}, K=({},{},{}): rel error {err:e}\ngot {got}\nexpected {expected}",
+        q.a,
+        q.b,
+        q.c
+    );
 }
 
 #[test]
 fn flat_mirror_keeps_sigma() {
-    check(&Quadric { a: 0.0, b: 0.0, c: 0.0 }, 0.0, Curvature::isotropic(0.0).unwrap());
-    check(&Quadric { a: 0.0, b: 0.0, c: 0.0 }, 0.7, Curvature::isotropic(0.0).unwrap());
+    check(
+        &Quadric {
+            a: 0.0,
+            b: 0.0,
+            c: 0.0,
+        },
+        0.0,
+        Curvature::isotropic(0.0).unwrap(),
+    );
+    check(
+        &Quadric {
+            a: 0.0,
+            b: 0.0,
+            c: 0.0,
+        },
+        0.7,
+        Curvature::isotropic(0.0).unwrap(),
+    );
 }
 
 #[test]
 fn convex_and_concave_spheres_at_normal_incidence() {
     for k in [0.5, 2.0, -1.0] {
-        check(&Quadric { a: k, b: 0.0, c: k }, 0.0, Curvature::isotropic(k).unwrap());
+        check(
+            &Quadric { a: k, b: 0.0, c: k },
+            0.0,
+            Curvature::isotropic(k).unwrap(),
+        );
     }
 }
 
@@ -133,7 +173,15 @@ fn anisotropic_curvature_at_normal_incidence() {
 #[test]
 fn oblique_incidence_with_curvature_across_the_plane() {
     let cv = Curvature::anisotropic(0.0, 1.5, 0.0).unwrap();
-    check(&Quadric { a: 0.0, b: 0.0, c: 1.5 }, 0.5, cv);
+    check(
+        &Quadric {
+            a: 0.0,
+            b: 0.0,
+            c: 1.5,
+        },
+        0.5,
+        cv,
+    );
 }
 
 /// Oblique incidence with a full anisotropic tensor (in-plane, across and mixed terms).
@@ -149,7 +197,11 @@ fn oblique_incidence_anisotropic() {
 #[test]
 fn convex_mirror_diverges() {
     // Parallel rays (u = 0) at x > 0 leave with u > 0 on a convex mirror.
-    let q = Quadric { a: 1.0, b: 0.0, c: 1.0 };
+    let q = Quadric {
+        a: 1.0,
+        b: 0.0,
+        c: 1.0,
+    };
     let (fin, fout) = frames(0.0);
     let out = trace(&q, &fin, &fout, &[0.01, 0.0, 0.0, 0.0]);
     assert!(out[2] > 0.0);

@@ -15,7 +15,11 @@ impl<const N: usize> Cov<N> {
     /// The (position, direction) axis pairs of this layout: `[(x, u)]` in flatland,
     /// `[(x, u), (y, v)]` in 3D. Flatland operator definitions apply to each pair.
     pub fn transverse_pairs() -> &'static [(Axis, Axis)] {
-        if N >= 4 { &[(Axis::X, Axis::U), (Axis::Y, Axis::V)] } else { &[(Axis::X, Axis::U)] }
+        if N >= 4 {
+            &[(Axis::X, Axis::U), (Axis::Y, Axis::V)]
+        } else {
+            &[(Axis::X, Axis::U)]
+        }
     }
 
     /// The direction axes of this layout: `[u]` or `[u, v]`.

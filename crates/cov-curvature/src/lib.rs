@@ -98,13 +98,27 @@ impl Curvature {
     ///
     /// # Errors
     /// `cos` not in (0, 1], `sign` not finite, overflow.
-    pub fn apply_oblique<const N: usize>(&self, cov: &mut Cov<N>, cos: f64, sign: f64) -> Result<(), CovError> {
-        CovError::check_range(Self::NAME, "cos", cos, |c| c > 0.0 && c <= 1.0, "must be in (0, 1]")?;
+    pub fn apply_oblique<const N: usize>(
+        &self,
+        cov: &mut Cov<N>,
+        cos: f64,
+        sign: f64,
+    ) -> Result<(), CovError> {
+        CovError::check_range(
+            Self::NAME,
+            "cos",
+            cos,
+            |c| c > 0.0 && c <= 1.0,
+            "must be in (0, 1]",
+        )?;
         CovError::check_finite(Self::NAME, "sign", sign)?;
         let (kxx, kxy, kyy) = self.tensor();
         if !Cov::<N>::has(Axis::Y) {
             if !self.is_isotropic() {
-                return Err(CovError::MissingAxis { axis: Axis::Y, layout: N });
+                return Err(CovError::MissingAxis {
+                    axis: Axis::Y,
+                    layout: N,
+                });
             }
             return cov.shear(Axis::U, Axis::X, sign * kxx);
         }
@@ -138,7 +152,11 @@ impl<const N: usize> Operator<N> for Curvature {
         Self::NAME
     }
     fn requires(&self) -> AxisSet {
-        if self.is_isotropic() { AxisSet::FLAT } else { AxisSet::SPACE }
+        if self.is_isotropic() {
+            AxisSet::FLAT
+        } else {
+            AxisSet::SPACE
+        }
     }
 }
 
@@ -187,6 +205,10 @@ impl<const N: usize> Operator<N> for CurvatureTensor {
         Self::NAME
     }
     fn requires(&self) -> AxisSet {
-        if self.k[1] != 0.0 || self.k[2] != 0.0 { AxisSet::SPACE } else { AxisSet::FLAT }
+        if self.k[1] != 0.0 || self.k[2] != 0.0 {
+            AxisSet::SPACE
+        } else {
+            AxisSet::FLAT
+        }
     }
 }

@@ -49,7 +49,9 @@ fn thick_occluder_matches_sliced_ground_truth() {
     Operator::<2>::apply(&ThickOccluder::new(0.4, 4, 0.15).unwrap(), &mut p).unwrap();
     let mut f = Field::gaussian(&stds);
     for _ in 0..4 {
-        f = f.then(Primal::gaussian_window(0, 0.15)).then(Primal::travel(2, 0.1));
+        f = f
+            .then(Primal::gaussian_window(0, 0.15))
+            .then(Primal::travel(2, 0.1));
     }
     let r = compare(&f, &p, &Grid::auto(&p, 64, &[1.0; 2])).unwrap();
     assert!(r.rel_error < 1e-3, "thick: {:e}", r.rel_error);
@@ -65,8 +67,9 @@ fn hard_blocker_edge_approximation_error() {
     let stds = [0.5, f64::INFINITY];
     let mut p = Cov::<2>::gaussian(stds).unwrap();
     Operator::<2>::apply(&BlockerEdge::new(r_edge).unwrap(), &mut p).unwrap();
-    let f = Field::gaussian(&stds)
-        .then(Primal::Window(Arc::new(move |z: &[f64]| if z[0] > -r_edge { 1.0 } else { 0.0 })));
+    let f = Field::gaussian(&stds).then(Primal::Window(Arc::new(
+        move |z: &[f64]| if z[0] > -r_edge { 1.0 } else { 0.0 },
+    )));
     let mut last = 0.0;
     for size in [64, 128, 256] {
         let r = compare(&f, &p, &Grid::auto(&p, size, &[1.0, 1.0])).unwrap();

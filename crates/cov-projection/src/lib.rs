@@ -48,11 +48,19 @@ fn check_cos(op: &str, c: f64) -> Result<f64, CovError> {
 }
 
 fn rotate<const N: usize>(cov: &mut Cov<N>, angle: f64) -> Result<(), CovError> {
-    if angle != 0.0 { cov.rotate_frame(angle) } else { Ok(()) }
+    if angle != 0.0 {
+        cov.rotate_frame(angle)
+    } else {
+        Ok(())
+    }
 }
 
 fn needs(angle: f64) -> AxisSet {
-    if angle != 0.0 { AxisSet::SPACE } else { AxisSet::FLAT }
+    if angle != 0.0 {
+        AxisSet::SPACE
+    } else {
+        AxisSet::FLAT
+    }
 }
 
 /// Projection from the ray's transverse plane onto the surface.
@@ -115,7 +123,11 @@ impl Project {
         let frame_y = dir.cross(frame_x);
         let p = normal - normal.dot(dir) * dir;
         // At (near-)normal incidence every transverse axis is in the plane of incidence.
-        let angle = if p.length() <= 1e-12 { 0.0 } else { p.dot(frame_y).atan2(p.dot(frame_x)) };
+        let angle = if p.length() <= 1e-12 {
+            0.0
+        } else {
+            p.dot(frame_y).atan2(p.dot(frame_x))
+        };
         Self::with_angle(cos, angle)
     }
 

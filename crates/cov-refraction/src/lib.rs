@@ -57,7 +57,13 @@ impl Refract {
     pub fn new(n1: f64, n2: f64, cos_i: f64) -> Result<Self, CovError> {
         CovError::check_positive(Self::NAME, "n1", n1)?;
         CovError::check_positive(Self::NAME, "n2", n2)?;
-        CovError::check_range(Self::NAME, "cos_i", cos_i, |c| c > 0.0 && c <= 1.0, "must be in (0, 1]")?;
+        CovError::check_range(
+            Self::NAME,
+            "cos_i",
+            cos_i,
+            |c| c > 0.0 && c <= 1.0,
+            "must be in (0, 1]",
+        )?;
         let eta = n1 / n2;
         // sin²θ_i = (1 − cos)(1 + cos): no cancellation near normal incidence.
         let sin2_i = (1.0 - cos_i) * (1.0 + cos_i);

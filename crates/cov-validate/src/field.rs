@@ -33,7 +33,12 @@ impl fmt::Debug for Primal {
         match self {
             Primal::Map(a) => write!(f, "Map({a:?})"),
             Primal::Window(_) => write!(f, "Window"),
-            Primal::Convolve { axis, half_width, nodes, .. } => {
+            Primal::Convolve {
+                axis,
+                half_width,
+                nodes,
+                ..
+            } => {
                 write!(f, "Convolve(axis {axis}, ±{half_width}, {nodes} nodes)")
             }
         }
@@ -43,7 +48,9 @@ impl fmt::Debug for Primal {
 impl Primal {
     /// Identity matrix of size `n`, row-major.
     pub fn identity(n: usize) -> Vec<f64> {
-        (0..n * n).map(|k| if k / n == k % n { 1.0 } else { 0.0 }).collect()
+        (0..n * n)
+            .map(|k| if k / n == k % n { 1.0 } else { 0.0 })
+            .collect()
     }
 
     /// `l'(z) = l(z')` with `z'_target = z_target + s·z_source`.
@@ -73,7 +80,9 @@ impl Primal {
 
     /// A Gaussian window of std `std` along `axis`: `w = exp(−z²/2s²)`.
     pub fn gaussian_window(axis: usize, std: f64) -> Primal {
-        Primal::Window(Arc::new(move |z: &[f64]| (-0.5 * z[axis] * z[axis] / (std * std)).exp()))
+        Primal::Window(Arc::new(move |z: &[f64]| {
+            (-0.5 * z[axis] * z[axis] / (std * std)).exp()
+        }))
     }
 
     /// A Gaussian lobe of variance `var` along `axis` (quadrature over ±8 std).
@@ -160,7 +169,11 @@ impl Field {
             }
             Primal::Window(w) => {
                 let v = w(z);
-                if v == 0.0 { 0.0 } else { v * self.eval_upto(k - 1, z) }
+                if v == 0.0 {
+                    0.0
+                } else {
+                    v * self.eval_upto(k - 1, z)
+                }
             }
             Primal::Convolve {
                 axis,

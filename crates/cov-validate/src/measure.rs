@@ -198,7 +198,10 @@ pub fn compare<const N: usize>(
     grid: &Grid,
 ) -> Result<Comparison, ValidateError> {
     if field.dim() != N {
-        return Err(ValidateError::Config(format!("field has N = {}, prediction {N}", field.dim())));
+        return Err(ValidateError::Config(format!(
+            "field has N = {}, prediction {N}",
+            field.dim()
+        )));
     }
     let t0 = Instant::now();
     let measured = measure(field, grid)?;
@@ -212,7 +215,11 @@ pub fn compare<const N: usize>(
         .collect();
     let sd = DMatrix::from_fn(N, N, |i, j| diff[(i, j)] * scale[i] * scale[j]);
     let sp = DMatrix::from_fn(N, N, |i, j| p[(i, j)] * scale[i] * scale[j]);
-    let rel_error_scaled = if sp.norm() > 0.0 { sd.norm() / sp.norm() } else { sd.norm() };
+    let rel_error_scaled = if sp.norm() > 0.0 {
+        sd.norm() / sp.norm()
+    } else {
+        sd.norm()
+    };
     Ok(Comparison {
         predicted: p,
         measured,
@@ -257,10 +264,20 @@ mod tests {
     #[test]
     fn three_and_four_dimensions() {
         let p3 = Cov::<3>::gaussian([0.2, 0.05, 0.01]).unwrap();
-        let r = compare(&Field::gaussian(&[0.2, 0.05, 0.01]), &p3, &Grid::auto(&p3, 48, &[1.0; 3])).unwrap();
+        let r = compare(
+            &Field::gaussian(&[0.2, 0.05, 0.01]),
+            &p3,
+            &Grid::auto(&p3, 48, &[1.0; 3]),
+        )
+        .unwrap();
         assert!(r.rel_error < 1e-3, "{r:?}");
         let p4 = Cov::<4>::gaussian([0.2, 0.1, 0.05, 0.07]).unwrap();
-        let r = compare(&Field::gaussian(&[0.2, 0.1, 0.05, 0.07]), &p4, &Grid::auto(&p4, 24, &[1.0; 4])).unwrap();
+        let r = compare(
+            &Field::gaussian(&[0.2, 0.1, 0.05, 0.07]),
+            &p4,
+            &Grid::auto(&p4, 24, &[1.0; 4]),
+        )
+        .unwrap();
         assert!(r.rel_error < 1e-3, "{r:?}");
     }
 }
