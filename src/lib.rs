@@ -21,3 +21,27 @@
 //! ```
 
 pub use cov_core::*;
+
+/// Free-space travel (crate `cov-travel`, feature `travel`).
+#[cfg(feature = "travel")]
+pub use cov_travel as travel;
+
+/// Occluders, blocker edges, textures (crate `cov-occlusion`, feature `occlusion`).
+#[cfg(feature = "occlusion")]
+pub use cov_occlusion as occlusion;
+
+/// Projection, mirror symmetry, frame rotation (crate `cov-projection`, feature `projection`).
+#[cfg(feature = "projection")]
+pub use cov_projection as projection;
+
+/// Curvature (crate `cov-curvature`, feature `curvature`).
+#[cfg(feature = "curvature")]
+pub use cov_curvature as curvature;
+
+/// BRDF lobes and reflection (crate `cov-brdf`, feature `brdf`).
+#[cfg(feature = "brdf")]
+pub use cov_brdf as brdf;
+
+/// Refraction (crate `cov-refraction`, feature `refraction`).
+#[cfg(feature = "refraction")]
+pub use cov_refraction as refraction;

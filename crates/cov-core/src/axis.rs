@@ -172,10 +172,19 @@ pub fn layout_set(n: usize) -> AxisSet {
 ///
 /// # Errors
 /// [`CovError::MissingAxis`] when the layout has no such axis.
+#[inline]
 pub fn axis_index(n: usize, axis: Axis) -> Result<usize, CovError> {
-    layout_axes(n)
-        .and_then(|axes| axes.iter().position(|a| *a == axis))
-        .ok_or(CovError::MissingAxis { axis, layout: n })
+    let i = match (n, axis) {
+        (2 | 3, Axis::X) | (4 | 5, Axis::X) => Some(0),
+        (2 | 3, Axis::U) => Some(1),
+        (3, Axis::T) => Some(2),
+        (4 | 5, Axis::Y) => Some(1),
+        (4 | 5, Axis::U) => Some(2),
+        (4 | 5, Axis::V) => Some(3),
+        (5, Axis::T) => Some(4),
+        _ => None,
+    };
+    i.ok_or(CovError::MissingAxis { axis, layout: n })
 }
 
 #[cfg(test)]

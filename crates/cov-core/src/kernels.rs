@@ -81,23 +81,27 @@ impl<const N: usize> Cov<N> {
         if s == 0.0 {
             return Ok(());
         }
-        let old = *self;
-        self.shear_idx(i, j, s);
-        self.finish("shear", old)
-    }
-
-    #[inline(always)]
-    pub(crate) fn shear_idx(&mut self, i: usize, j: usize, s: f64) {
-        let sii = self.get(i, i);
-        let sij = self.get(i, j);
-        let sjj = self.get(j, j);
-        for k in 0..N {
-            if k != j {
-                let v = self.get(k, j) + s * self.get(k, i);
-                self.set(k, j, v);
-            }
+        // Compute the new column j, check it, then commit: Σ is untouched on overflow.
+        let mut col = [0.0; N];
+        for (k, c) in col.iter_mut().enumerate() {
+            *c = if k == j {
+                self.get(j, j) + s * (2.0 * self.get(i, j) + s * self.get(i, i))
+            } else {
+                self.get(k, j) + s * self.get(k, i)
+            };
         }
-        self.set(j, j, sjj + s * (2.0 * sij + s * sii));
+        if let Some(k) = col.iter().position(|v| !v.is_finite()) {
+            return Err(CovError::Overflow {
+                operator: "shear".into(),
+                row: k.min(j),
+                col: k.max(j),
+                value: col[k],
+            });
+        }
+        for (k, c) in col.iter().enumerate() {
+            self.set(k, j, *c);
+        }
+        Ok(())
     }
 
     /// Rule 1, scaling: `l'(z) = l(z')` with `z'_axis = c·z_axis` (a projection by a

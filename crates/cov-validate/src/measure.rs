@@ -156,7 +156,7 @@ fn fft_nd(data: &mut [Complex<f64>], n: usize, m: usize) {
         let total = data.len();
         for base in 0..total {
             // `base` is the start of a line when its coordinate along `axis` is 0.
-            if (base / stride) % m != 0 {
+            if !(base / stride).is_multiple_of(m) {
                 continue;
             }
             for k in 0..m {

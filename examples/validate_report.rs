@@ -1,0 +1,210 @@
+//! The error-against-run-time report: for a bundled set of flatland chains, the closed-form
+//! prediction against the brute-force measurement (cov-validate) at several grid sizes.
+//! Prints case | relative error | time to predict | time to measure, and writes the
+//! error-vs-run-time chart as SVG.
+//!
+//! Run: `cargo run --release --example validate_report [-- OUT.svg] [--full]`
+//! (default output `validate_report.svg`; `--full` adds the 512 grid).
+
+use std::sync::Arc;
+use std::time::Instant;
+
+use cov_validate::{Field, Grid, Primal, compare};
+use covtrace::brdf::{Brdf, Lobe, Reflect};
+use covtrace::curvature::Curvature;
+use covtrace::occlusion::{BlockerEdge, Window};
+use covtrace::refraction::Refract;
+use covtrace::travel::Travel;
+use covtrace::{Chain, Cov};
+use plotters::prelude::*;
+
+struct Case {
+    name: &'static str,
+    gaussian: bool,
+    chain: Chain<2>,
+    field: Field,
+}
+
+const STDS: [f64; 2] = [0.1, 0.2];
+
+fn cases() -> Result<Vec<Case>, Box<dyn std::error::Error>> {
+    let f0 = || Field::gaussian(&STDS);
+    let refract = Refract::new(1.0, 1.5, 0.8)?;
+    let ggx_a2 = 4.0 * 0.1 * 0.1;
+    Ok(vec![
+        Case {
+            name: "travel 1 m",
+            gaussian: true,
+            chain: Chain::new().with(Travel::new(1.0)?),
+            field: f0().then(Primal::travel(2, 1.0)),
+        },
+        Case {
+            name: "window + travel",
+            gaussian: true,
+            chain: Chain::new()
+                .with(Window::isotropic(0.05)?)
+                .with(Travel::new(0.5)?),
+            field: f0()
+                .then(Primal::gaussian_window(0, 0.05))
+                .then(Primal::travel(2, 0.5)),
+        },
+        Case {
+            name: "Phong 100 lobe",
+            gaussian: true,
+            chain: Chain::new()
+                .with(Travel::new(0.3)?)
+                .with(Brdf::new(Lobe::phong(100.0)?)?),
+            field: f0()
+                .then(Primal::travel(2, 0.3))
+                .then(Primal::gaussian_lobe(1, 0.01, 129)),
+        },
+        Case {
+            name: "curved glossy reflector",
+            gaussian: true,
+            chain: Chain::new().with(Reflect::new(
+                0.8,
+                0.8,
+                Curvature::isotropic(2.0)?,
+                Lobe::phong(200.0)?,
+            )?),
+            field: f0()
+                .then(Primal::scale(2, 0, 0.8))
+                .then(Primal::scale(2, 1, -1.0))
+                .then(Primal::shear(2, 1, 0, 2.0))
+                .then(Primal::scale(2, 1, -1.0))
+                .then(Primal::gaussian_lobe(1, 1.0 / 200.0, 129))
+                .then(Primal::shear(2, 1, 0, -2.0))
+                .then(Primal::scale(2, 0, 1.0 / 0.8)),
+        },
+        Case {
+            name: "refraction air→glass",
+            gaussian: true,
+            chain: Chain::new().with(refract),
+            field: f0()
+                .then(Primal::scale(2, 0, 0.8 / refract.cos_t()))
+                .then(Primal::scale(2, 1, 1.0 / refract.angular_scale())),
+        },
+        Case {
+            name: "hard blocker edge (non-Gaussian)",
+            gaussian: false,
+            chain: Chain::new().with(BlockerEdge::new(0.05)?),
+            field: f0().then(Primal::Window(Arc::new(
+                |z: &[f64]| if z[0] > -0.05 { 1.0 } else { 0.0 },
+            ))),
+        },
+        Case {
+            name: "GGX α=0.1 lobe (heavy tail)",
+            gaussian: false,
+            chain: Chain::new()
+                .with(Travel::new(0.3)?)
+                .with(Brdf::new(Lobe::ggx(0.1)?)?),
+            field: f0().then(Primal::travel(2, 0.3)).then(Primal::Convolve {
+                axis: 1,
+                lobe: Arc::new(move |u| (1.0 + u * u / ggx_a2).powf(-1.5)),
+                half_width: 3.0,
+                nodes: 2001,
+            }),
+        },
+    ])
+}
+
+fn main() -> Result<(), Box<dyn std::error::Error>> {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    let full = args.iter().any(|a| a == "--full");
+    let out = args
+        .iter()
+        .find(|a| !a.starts_with("--"))
+        .cloned()
+        .unwrap_or("validate_report.svg".into());
+    let mut sizes = vec![32, 64, 128, 256];
+    if full {
+        sizes.push(512);
+    }
+    let start = Cov::<2>::gaussian(STDS)?;
+    println!(
+        "{:<34} {:>5} {:>12} {:>12} {:>14} {:>13}",
+        "case", "grid", "rel error", "scaled err", "predict [µs]", "measure [ms]"
+    );
+    let mut series = Vec::new();
+    for case in cases()? {
+        // Prediction time: mean over many evaluations.
+        let reps = 20_000;
+        let t0 = Instant::now();
+        let mut predicted = start;
+        for _ in 0..reps {
+            predicted = std::hint::black_box(&case.chain).eval(std::hint::black_box(start))?;
+        }
+        let predict_us = t0.elapsed().as_secs_f64() / f64::from(reps) * 1e6;
+        let mut points = Vec::new();
+        for &n in &sizes {
+            let r = compare(&case.field, &predicted, &Grid::auto(&predicted, n, &[1.0, 1.0]))?;
+            println!(
+                "{:<34} {:>5} {:>12.3e} {:>12.3e} {:>14.3} {:>13.3}",
+                case.name,
+                n,
+                r.rel_error,
+                r.rel_error_scaled,
+                predict_us,
+                r.measure_seconds * 1e3
+            );
+            points.push((r.measure_seconds * 1e3, r.rel_error.max(1e-9)));
+        }
+        series.push((case.name, case.gaussian, predict_us, points));
+    }
+    draw(&out, &series)?;
+    println!("\nchart written to {out}");
+    Ok(())
+}
+
+type Series = (&'static str, bool, f64, Vec<(f64, f64)>);
+
+fn draw(path: &str, series: &[Series]) -> Result<(), Box<dyn std::error::Error>> {
+    let root = SVGBackend::new(path, (900, 560)).into_drawing_area();
+    root.fill(&WHITE)?;
+    let (mut tmin, mut tmax, mut emin, mut emax) = (f64::MAX, 0.0f64, f64::MAX, 0.0f64);
+    for (_, _, _, pts) in series {
+        for &(t, e) in pts {
+            tmin = tmin.min(t);
+            tmax = tmax.max(t);
+            emin = emin.min(e);
+            emax = emax.max(e);
+        }
+    }
+    let mut chart = ChartBuilder::on(&root)
+        .caption(
+            "cov-validate: brute-force error against measurement time",
+            ("sans-serif", 20),
+        )
+        .margin(15)
+        .x_label_area_size(45)
+        .y_label_area_size(70)
+        .build_cartesian_2d(
+            (tmin * 0.5..tmax * 2.0).log_scale(),
+            (emin * 0.3..emax * 3.0).log_scale(),
+        )?;
+    chart
+        .configure_mesh()
+        .x_desc("time to measure [ms] (grid 32 → 256 per axis)")
+        .y_desc("‖Σ_measured − Σ_predicted‖ / ‖Σ_predicted‖")
+        .draw()?;
+    for (i, (name, gaussian, predict_us, pts)) in series.iter().enumerate() {
+        let color = Palette99::pick(i).to_rgba();
+        let label = format!(
+            "{name}{} — predict {predict_us:.2} µs",
+            if *gaussian { "" } else { " [approx.]" }
+        );
+        chart
+            .draw_series(LineSeries::new(pts.iter().copied(), color.stroke_width(2)))?
+            .label(label)
+            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 18, y)], color.stroke_width(2)));
+        chart.draw_series(pts.iter().map(|&p| Circle::new(p, 3, color.filled())))?;
+    }
+    chart
+        .configure_series_labels()
+        .background_style(WHITE.mix(0.85))
+        .border_style(BLACK)
+        .position(SeriesLabelPosition::UpperRight)
+        .draw()?;
+    root.present()?;
+    Ok(())
+}
