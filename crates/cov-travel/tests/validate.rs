@@ -27,7 +27,7 @@ fn travel_matches_ground_truth_2d_3d_4d() {
     let mut p = Cov::<4>::gaussian(stds4).unwrap();
     Operator::<4>::apply(&Travel::new(0.5).unwrap(), &mut p).unwrap();
     let f = Field::gaussian(&stds4).then(Primal::travel(4, 0.5));
-    let r = compare(&f, &p, &Grid::auto(&p, 24, &[1.0; 4])).unwrap();
+    let r = compare(&f, &p, &Grid::auto(&p, 32, &[1.0; 4])).unwrap();
     assert!(r.rel_error < 1e-3, "4D: {:e}", r.rel_error);
 }
 
