@@ -29,4 +29,4 @@ mod field;
 mod measure;
 
 pub use field::{Field, Primal, PrimalFn};
-pub use measure::{Comparison, Grid, ValidateError, compare, measure};
+pub use measure::{Comparison, Grid, ValidateError, WINDOW_FRACTION, compare, measure};
