@@ -66,6 +66,7 @@ impl<const N: usize> Cov<N> {
     ///
     /// # Errors
     /// [`CovError::MissingAxis`] if the layout has no such axis (e.g. `t` when `N = 4`).
+    #[inline]
     pub fn index(axis: Axis) -> Result<usize, CovError> {
         axis_index(N, axis)
     }
@@ -260,6 +261,7 @@ impl<const N: usize> Cov<N> {
     ///
     /// # Errors
     /// [`CovError::Overflow`] naming `operator` and the first non-finite entry.
+    #[inline]
     pub fn check_finite(&self, operator: &str) -> Result<(), CovError> {
         for i in 0..N {
             for j in i..N {

@@ -108,15 +108,21 @@ impl CovError {
     ///
     /// # Errors
     /// [`CovError::NonFinite`] if `value` is NaN or infinite.
+    #[inline]
     pub fn check_finite(operator: &str, parameter: &str, value: f64) -> Result<f64, CovError> {
         if value.is_finite() {
             Ok(value)
         } else {
-            Err(CovError::NonFinite {
-                operator: operator.into(),
-                parameter: parameter.into(),
-                value,
-            })
+            Err(Self::non_finite(operator, parameter, value))
+        }
+    }
+
+    #[cold]
+    fn non_finite(operator: &str, parameter: &str, value: f64) -> CovError {
+        CovError::NonFinite {
+            operator: operator.into(),
+            parameter: parameter.into(),
+            value,
         }
     }
 
@@ -125,6 +131,7 @@ impl CovError {
     ///
     /// # Errors
     /// [`CovError::NonFinite`] or [`CovError::OutOfRange`].
+    #[inline]
     pub fn check_range(
         operator: &str,
         parameter: &str,
@@ -136,12 +143,17 @@ impl CovError {
         if ok(value) {
             Ok(value)
         } else {
-            Err(CovError::OutOfRange {
-                operator: operator.into(),
-                parameter: parameter.into(),
-                value,
-                expected: expected.into(),
-            })
+            Err(Self::out_of_range(operator, parameter, value, expected))
+        }
+    }
+
+    #[cold]
+    fn out_of_range(operator: &str, parameter: &str, value: f64, expected: &str) -> CovError {
+        CovError::OutOfRange {
+            operator: operator.into(),
+            parameter: parameter.into(),
+            value,
+            expected: expected.into(),
         }
     }
 
@@ -149,6 +161,7 @@ impl CovError {
     ///
     /// # Errors
     /// [`CovError::NonFinite`] or [`CovError::OutOfRange`].
+    #[inline]
     pub fn check_positive(operator: &str, parameter: &str, value: f64) -> Result<f64, CovError> {
         Self::check_range(operator, parameter, value, |v| v > 0.0, "must be > 0")
     }
@@ -157,6 +170,7 @@ impl CovError {
     ///
     /// # Errors
     /// [`CovError::NonFinite`] or [`CovError::OutOfRange`].
+    #[inline]
     pub fn check_non_negative(operator: &str, parameter: &str, value: f64) -> Result<f64, CovError> {
         Self::check_range(operator, parameter, value, |v| v >= 0.0, "must be >= 0")
     }

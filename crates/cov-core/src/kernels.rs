@@ -67,6 +67,7 @@ impl<const N: usize> Cov<N> {
     ///
     /// # Errors
     /// Missing axis, `target == source`, non-finite `s`, or an overflowing result.
+    #[inline]
     pub fn shear(&mut self, target: Axis, source: Axis, s: f64) -> Result<(), CovError> {
         CovError::check_finite("shear", "s", s)?;
         let i = Self::index(target)?;
@@ -109,6 +110,7 @@ impl<const N: usize> Cov<N> {
     ///
     /// # Errors
     /// Missing axis, non-finite `c`, or an overflowing result.
+    #[inline]
     pub fn scale(&mut self, axis: Axis, c: f64) -> Result<(), CovError> {
         CovError::check_finite("scale", "c", c)?;
         let i = Self::index(axis)?;
@@ -127,6 +129,7 @@ impl<const N: usize> Cov<N> {
     ///
     /// # Errors
     /// Missing axis, `a == b`, non-finite `angle`.
+    #[inline]
     pub fn rotate(&mut self, a: Axis, b: Axis, angle: f64) -> Result<(), CovError> {
         CovError::check_finite("rotate", "angle", angle)?;
         let i = Self::index(a)?;
@@ -188,6 +191,7 @@ impl<const N: usize> Cov<N> {
     ///
     /// # Errors
     /// Missing axis, `w` negative or non-finite, overflow.
+    #[inline]
     pub fn add_variance(&mut self, axis: Axis, w: f64) -> Result<(), CovError> {
         CovError::check_non_negative("add_variance", "w", w)?;
         let i = Self::index(axis)?;
@@ -226,7 +230,16 @@ impl<const N: usize> Cov<N> {
     ///
     /// # Errors
     /// Missing or repeated axis, wrong size, `S` not finite/symmetric/PSD; overflow.
+    #[inline]
     pub fn convolve(&mut self, axes: &[Axis], s: &[f64]) -> Result<(), CovError> {
+        if let ([axis], [s1]) = (axes, s) {
+            // One axis: S is a non-negative number; no eigen-check needed.
+            let p = Self::index(*axis)?;
+            CovError::check_non_negative("convolve", "S", *s1)?;
+            let old = *self;
+            self.lobe_product_1(p, *s1);
+            return self.finish("convolve", old);
+        }
         let (idx, k) = self.resolve("convolve", axes)?;
         let sm = block_from_slice("convolve", "S", k, s)?;
         let old = *self;
@@ -244,7 +257,13 @@ impl<const N: usize> Cov<N> {
     ///
     /// # Errors
     /// Missing or repeated axis.
+    #[inline]
     pub fn integrate(&mut self, axes: &[Axis]) -> Result<(), CovError> {
+        if let [axis] = axes {
+            let p = Self::index(*axis)?;
+            self.lobe_product_1(p, 0.0);
+            return Ok(());
+        }
         let (idx, k) = self.resolve("integrate", axes)?;
         let old = *self;
         self.lobe_product(&idx[..k], &[[0.0; MAX]; MAX]);
@@ -254,6 +273,10 @@ impl<const N: usize> Cov<N> {
     /// Shared by rules 3 and 4; `p` are the convolved indices, `s` the lobe spectrum.
     fn lobe_product(&mut self, p: &[usize], s: &Small) {
         let k = p.len();
+        if k == 1 {
+            self.lobe_product_1(p[0], s[0][0]);
+            return;
+        }
         let mut m = [[0.0; MAX]; MAX];
         for a in 0..k {
             for b in 0..k {
@@ -268,7 +291,15 @@ impl<const N: usize> Cov<N> {
                 t[a][b] = (0..k).map(|c| minv[a][c] * s[c][b]).sum();
             }
         }
-        let others: Vec<usize> = (0..N).filter(|i| !p.contains(i)).collect();
+        let mut others_buf = [0usize; MAX];
+        let mut no = 0;
+        for i in 0..N {
+            if !p.contains(&i) {
+                others_buf[no] = i;
+                no += 1;
+            }
+        }
+        let others = &others_buf[..no];
         let old = *self;
         // Σ_oo − Σ_op M⁺ Σ_po
         for (ai, &oa) in others.iter().enumerate() {
@@ -283,7 +314,7 @@ impl<const N: usize> Cov<N> {
             }
         }
         // Σ_op M⁺ S
-        for &o in &others {
+        for &o in others {
             for b in 0..k {
                 let v: f64 = (0..k).map(|c| old.get(o, p[c]) * t[c][b]).sum();
                 self.set(o, p[b], v);
@@ -297,6 +328,36 @@ impl<const N: usize> Cov<N> {
                 self.set(p[a], p[b], 0.5 * (ab + ba));
             }
         }
+    }
+
+    /// One convolved axis `p` with lobe spectrum `s ≥ 0` (the common case: a lobe on u,
+    /// or integration over one axis). Same forms as the general path, with
+    /// `m = s + Σ_pp`, `t = s/m`: `Σ_pp' = Σ_pp t`, `Σ_op' = Σ_op t`,
+    /// `Σ_oo' = Σ_oo − Σ_op Σ_po / m`. For `m = 0` (no content and a diffuse lobe) the
+    /// generalised inverse is 0 and only the axis itself is cleared.
+    #[inline]
+    fn lobe_product_1(&mut self, p: usize, s: f64) {
+        let spp = self.get(p, p);
+        let m = s + spp;
+        let (inv, t) = if m > 0.0 { (1.0 / m, s / m) } else { (0.0, 0.0) };
+        let mut col = [0.0; N];
+        for (o, c) in col.iter_mut().enumerate() {
+            *c = self.get(o, p);
+        }
+        for a in 0..N {
+            if a == p {
+                continue;
+            }
+            let ga = col[a] * inv;
+            for b in a..N {
+                if b != p {
+                    let v = self.get(a, b) - ga * col[b];
+                    self.set(a, b, v);
+                }
+            }
+            self.set(a, p, col[a] * t);
+        }
+        self.set(p, p, spp * t);
     }
 
     fn resolve(&self, op: &str, axes: &[Axis]) -> Result<([usize; MAX], usize), CovError> {
@@ -322,6 +383,7 @@ impl<const N: usize> Cov<N> {
     }
 
     /// Checks the result of a kernel; on overflow restores the input and reports.
+    #[inline]
     fn finish(&mut self, op: &str, old: Self) -> Result<(), CovError> {
         if let Err(e) = self.check_finite(op) {
             *self = old;
