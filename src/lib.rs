@@ -22,6 +22,39 @@
 
 pub use cov_core::*;
 
+/// RON light paths and the operator registry (crate `cov-path`).
+pub use cov_path as path;
+
+/// A registry with every operator this build includes (one per enabled feature).
+///
+/// ```
+/// let registry = covtrace::registry();
+/// let path = covtrace::path::Path::parse(
+///     "Path(source: Gaussian(x: 0.01), operators: [Travel(distance: 2.0), Brdf(lobe: Phong(exponent: 50))])",
+///     &registry,
+/// )?;
+/// let result = path.eval()?;
+/// assert_eq!(result.layout, 2); // inferred: nothing needs y, v or t
+/// # Ok::<(), covtrace::path::PathError>(())
+/// ```
+pub fn registry() -> cov_path::Registry {
+    #[allow(unused_mut)]
+    let mut r = cov_path::Registry::new();
+    #[cfg(feature = "travel")]
+    cov_travel::spec::register(&mut r);
+    #[cfg(feature = "occlusion")]
+    cov_occlusion::spec::register(&mut r);
+    #[cfg(feature = "projection")]
+    cov_projection::spec::register(&mut r);
+    #[cfg(feature = "curvature")]
+    cov_curvature::spec::register(&mut r);
+    #[cfg(feature = "brdf")]
+    cov_brdf::spec::register(&mut r);
+    #[cfg(feature = "refraction")]
+    cov_refraction::spec::register(&mut r);
+    r
+}
+
 /// Free-space travel (crate `cov-travel`, feature `travel`).
 #[cfg(feature = "travel")]
 pub use cov_travel as travel;

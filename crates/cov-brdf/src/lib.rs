@@ -48,12 +48,17 @@
 
 #![warn(missing_docs)]
 
+pub mod spec;
+
 use cov_core::{Cov, CovError, FOUR_PI_SQ, Operator};
 use cov_curvature::Curvature;
 use cov_projection::{Mirror, Project, Unproject};
 
-/// A reflectance (or transmittance) lobe over the outgoing direction.
-#[derive(Clone, Copy, Debug, PartialEq)]
+/// A reflectance (or transmittance) lobe over the outgoing direction. In RON:
+/// `Diffuse`, `Mirror`, `Phong(exponent: 100)`, `Gaussian(var_u: 0.01, var_v: 0.01)`,
+/// `Beckmann(alpha_u: 0.1, alpha_v: 0.1)`, `Ggx(alpha_u: 0.1, alpha_v: 0.2)`.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Deserialize, serde::Serialize)]
+#[serde(deny_unknown_fields)]
 pub enum Lobe {
     /// Lambertian: removes all angular content.
     Diffuse,

@@ -100,6 +100,14 @@ impl<const N: usize> Cov<N> {
         Ok(self.get(Self::index(a)?, Self::index(b)?))
     }
 
+    /// The same matrix as a `Cov<M>` when `M == N` (`None` otherwise): lets code that
+    /// dispatches on the layout at run time move between a generic `N` and a concrete
+    /// size without copying entry by entry.
+    #[inline]
+    pub fn cast<const M: usize>(&self) -> Option<Cov<M>> {
+        (M == N).then_some(Cov { p: self.p })
+    }
+
     /// The packed upper triangle, row by row (`N(N+1)/2` values).
     pub fn packed(&self) -> &[f64] {
         &self.p[..Self::PACKED_LEN]

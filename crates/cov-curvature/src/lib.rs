@@ -32,6 +32,8 @@
 
 #![warn(missing_docs)]
 
+pub mod spec;
+
 use cov_core::{Axis, AxisSet, Cov, CovError, Operator};
 
 /// Curvature by principal curvatures and direction.

@@ -30,6 +30,8 @@
 
 #![warn(missing_docs)]
 
+pub mod spec;
+
 use cov_core::{Axis, Cov, CovError, FOUR_PI_SQ, Operator};
 
 fn window_var(op: &str, name: &str, std: f64) -> Result<f64, CovError> {

@@ -40,6 +40,8 @@
 
 #![warn(missing_docs)]
 
+pub mod spec;
+
 use cov_core::{Axis, AxisSet, Cov, CovError, Operator};
 use glam::DVec3;
 

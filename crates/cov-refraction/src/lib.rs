@@ -35,6 +35,8 @@
 
 #![warn(missing_docs)]
 
+pub mod spec;
+
 use cov_brdf::Lobe;
 use cov_core::{Axis, Cov, CovError, Operator};
 

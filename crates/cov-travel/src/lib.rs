@@ -26,6 +26,8 @@
 
 #![warn(missing_docs)]
 
+pub mod spec;
+
 use cov_core::{Cov, CovError, Operator};
 
 /// Travel by `distance` metres along the ray.

@@ -1,10 +1,7 @@
-//! The error-against-run-time report: for a bundled set of flatland chains, the closed-form
-//! prediction against the brute-force measurement (cov-validate) at several grid sizes.
-//! Prints case | relative error | time to predict | time to measure, and writes the
-//! error-vs-run-time chart as SVG.
-//!
-//! Run: `cargo run --release --example validate_report [-- OUT.svg] [--full]`
-//! (default output `validate_report.svg`; `--full` adds the 512 grid).
+//! The error-against-run-time report (`covtrace validate`): for a bundled set of flatland
+//! chains, the closed-form prediction against the brute-force measurement (cov-validate)
+//! at several grid sizes: case | relative error | time to predict | time to measure, and
+//! the error-vs-run-time chart as SVG.
 
 use std::sync::Arc;
 use std::time::Instant;
@@ -18,16 +15,44 @@ use covtrace::travel::Travel;
 use covtrace::{Chain, Cov};
 use plotters::prelude::*;
 
-struct Case {
-    name: &'static str,
-    gaussian: bool,
-    chain: Chain<2>,
-    field: Field,
+/// One bundled chain: its operators and its primal field built from PHYSICS.md.
+pub struct Case {
+    /// Name in the table.
+    pub name: &'static str,
+    /// Whether the chain is Gaussian (exact closed form) or an approximation.
+    pub gaussian: bool,
+    /// The operators.
+    pub chain: Chain<2>,
+    /// The same chain as a primal light field.
+    pub field: Field,
+}
+
+/// One row of the report.
+#[derive(Clone, Debug)]
+pub struct Row {
+    /// Case name.
+    pub case: &'static str,
+    /// Whether the case is Gaussian.
+    pub gaussian: bool,
+    /// Grid size per axis.
+    pub grid: usize,
+    /// Plain Frobenius relative error.
+    pub rel_error: f64,
+    /// Unit-scaled relative error.
+    pub rel_error_scaled: f64,
+    /// Mean time to predict (µs).
+    pub predict_us: f64,
+    /// Time to measure (ms).
+    pub measure_ms: f64,
 }
 
 const STDS: [f64; 2] = [0.1, 0.2];
 
-fn cases() -> Result<Vec<Case>, Box<dyn std::error::Error>> {
+/// The bundled cases.
+///
+/// # Errors
+/// Never for the bundled parameters; an operator constructor's error otherwise.
+pub fn cases() -> Result<Vec<Case>, covtrace::CovError> {
     let f0 = || Field::gaussian(&STDS);
     let refract = Refract::new(1.0, 1.5, 0.8)?;
     let ggx_a2 = 4.0 * 0.1 * 0.1;
@@ -108,24 +133,22 @@ fn cases() -> Result<Vec<Case>, Box<dyn std::error::Error>> {
     ])
 }
 
-fn main() -> Result<(), Box<dyn std::error::Error>> {
-    let args: Vec<String> = std::env::args().skip(1).collect();
-    let full = args.iter().any(|a| a == "--full");
-    let out = args
-        .iter()
-        .find(|a| !a.starts_with("--"))
-        .cloned()
-        .unwrap_or("validate_report.svg".into());
-    let mut sizes = vec![32, 64, 128, 256];
+/// Grid sizes of the report: 32 to 256, and 512 with `full`.
+pub fn sizes(full: bool) -> Vec<usize> {
+    let mut v = vec![32, 64, 128, 256];
     if full {
-        sizes.push(512);
+        v.push(512);
     }
+    v
+}
+
+/// Runs every case at every size; `tick` is called after each measurement.
+///
+/// # Errors
+/// An operator or validator failure.
+pub fn run(sizes: &[usize], mut tick: impl FnMut(&Row)) -> Result<Vec<Row>, Box<dyn std::error::Error>> {
     let start = Cov::<2>::gaussian(STDS)?;
-    println!(
-        "{:<34} {:>5} {:>12} {:>12} {:>14} {:>13}",
-        "case", "grid", "rel error", "scaled err", "predict [µs]", "measure [ms]"
-    );
-    let mut series = Vec::new();
+    let mut rows = Vec::new();
     for case in cases()? {
         // Prediction time: mean over many evaluations.
         let reps = 20_000;
@@ -135,27 +158,61 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             predicted = std::hint::black_box(&case.chain).eval(std::hint::black_box(start))?;
         }
         let predict_us = t0.elapsed().as_secs_f64() / f64::from(reps) * 1e6;
-        let mut points = Vec::new();
-        for &n in &sizes {
+        for &n in sizes {
             let r = compare(&case.field, &predicted, &Grid::auto(&predicted, n, &[1.0, 1.0]))?;
-            println!(
-                "{:<34} {:>5} {:>12.3e} {:>12.3e} {:>14.3} {:>13.3}",
-                case.name,
-                n,
-                r.rel_error,
-                r.rel_error_scaled,
+            let row = Row {
+                case: case.name,
+                gaussian: case.gaussian,
+                grid: n,
+                rel_error: r.rel_error,
+                rel_error_scaled: r.rel_error_scaled,
                 predict_us,
-                r.measure_seconds * 1e3
-            );
-            points.push((r.measure_seconds * 1e3, r.rel_error.max(1e-9)));
+                measure_ms: r.measure_seconds * 1e3,
+            };
+            tick(&row);
+            rows.push(row);
         }
-        series.push((case.name, case.gaussian, predict_us, points));
     }
-    draw(&out, &series)?;
-    println!("\nchart written to {out}");
-    Ok(())
+    Ok(rows)
 }
 
+/// The table header.
+pub fn header() -> String {
+    format!(
+        "{:<34} {:>5} {:>12} {:>12} {:>14} {:>13}",
+        "case", "grid", "rel error", "scaled err", "predict [µs]", "measure [ms]"
+    )
+}
+
+/// One table line.
+pub fn line(r: &Row) -> String {
+    format!(
+        "{:<34} {:>5} {:>12.3e} {:>12.3e} {:>14.3} {:>13.3}",
+        r.case, r.grid, r.rel_error, r.rel_error_scaled, r.predict_us, r.measure_ms
+    )
+}
+
+/// Writes the error-vs-run-time chart (SVG) of `rows`.
+///
+/// # Errors
+/// The file cannot be written.
+pub fn chart(path: &str, rows: &[Row]) -> Result<(), Box<dyn std::error::Error>> {
+    let mut series: Vec<Series> = Vec::new();
+    for r in rows {
+        match series.last_mut() {
+            Some(s) if s.0 == r.case => s.3.push((r.measure_ms, r.rel_error.max(1e-16))),
+            _ => series.push((
+                r.case,
+                r.gaussian,
+                r.predict_us,
+                vec![(r.measure_ms, r.rel_error.max(1e-16))],
+            )),
+        }
+    }
+    draw(path, &series)
+}
+
+/// (case, gaussian, predict µs, (measure ms, error) per grid).
 type Series = (&'static str, bool, f64, Vec<(f64, f64)>);
 
 fn draw(path: &str, series: &[Series]) -> Result<(), Box<dyn std::error::Error>> {

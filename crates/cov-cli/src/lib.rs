@@ -1,0 +1,62 @@
+//! # cov-cli: the `covtrace` command line
+//!
+//! - `covtrace eval PATH.ron [--json]`: Σ after every step (axis names, bandwidths); with
+//!   `--json`, the axis names, each step's operator and full matrix, and the final matrix,
+//!   readable back with `cov_path::Evaluation::from_json`.
+//! - `covtrace plot PATH.ron -o FILE.png`: the spectrum ellipses after each step.
+//! - `covtrace validate [--full] [-o FILE.svg]`: the brute-force error-against-run-time report.
+//! - `covtrace list`: the registered operators with their parameters and units.
+//!
+//! Every error is one line, `file:line:column: message`, with exit code 2.
+
+#![warn(missing_docs)]
+
+pub mod plot;
+pub mod report;
+
+use covtrace::path::Evaluation;
+
+/// The human-readable table of an evaluation.
+pub fn format_evaluation(name: &str, e: &Evaluation) -> String {
+    let mut out = String::new();
+    let how = if e.inferred {
+        "inferred from what the path needs"
+    } else {
+        "declared"
+    };
+    out.push_str(&format!(
+        "path: {name}\nlayout: {} ({}), {how}\n\n",
+        e.layout,
+        e.axes.join(",")
+    ));
+    out.push_str(&format!("{:>5}  {:<14}", "step", "operator"));
+    for a in &e.axes {
+        out.push_str(&format!(" {:>12}", format!("bw {a}")));
+    }
+    out.push_str("   [bandwidth √Σ_ii, cycles per unit]\n");
+    let bw = |m: &Vec<Vec<f64>>| -> Vec<f64> { (0..m.len()).map(|i| m[i][i].max(0.0).sqrt()).collect() };
+    let mut row = |label: &str, name: &str, b: &[f64]| {
+        out.push_str(&format!("{label:>5}  {name:<14}"));
+        for v in b {
+            out.push_str(&format!(" {v:>12.4e}"));
+        }
+        out.push('\n');
+    };
+    row("-", "source", &bw(&e.start));
+    for (i, s) in e.steps.iter().enumerate() {
+        row(&i.to_string(), &s.operator, &s.bandwidths);
+    }
+    out.push_str("\nfinal Σ:\n     ");
+    for a in &e.axes {
+        out.push_str(&format!(" {a:>12}"));
+    }
+    out.push('\n');
+    for (i, r) in e.result.iter().enumerate() {
+        out.push_str(&format!("  {:>2} ", e.axes[i]));
+        for v in r {
+            out.push_str(&format!(" {v:>12.4e}"));
+        }
+        out.push('\n');
+    }
+    out
+}

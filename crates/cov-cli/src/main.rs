@@ -1,0 +1,116 @@
+//! The `covtrace` command line (see the crate docs of `cov-cli`).
+
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+use clap::{Parser, Subcommand};
+use cov_cli::{format_evaluation, plot, report};
+use covtrace::path::Path;
+use indicatif::{ProgressBar, ProgressStyle};
+
+#[derive(Parser)]
+#[command(
+    name = "covtrace",
+    version,
+    about = "Covariance tracing: frequency analysis of light transport"
+)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Trace a RON path: Σ after every step.
+    Eval {
+        /// The path file.
+        path: PathBuf,
+        /// Print JSON (axis names, every step's matrix, the final matrix).
+        #[arg(long)]
+        json: bool,
+    },
+    /// Draw the spectrum ellipses after every step.
+    Plot {
+        /// The path file.
+        path: PathBuf,
+        /// Output PNG.
+        #[arg(short, long)]
+        output: PathBuf,
+    },
+    /// The brute-force error-against-run-time report.
+    Validate {
+        /// Add the 512-point grid (slow).
+        #[arg(long)]
+        full: bool,
+        /// Output chart (SVG).
+        #[arg(short, long, default_value = "validate_report.svg")]
+        output: String,
+    },
+    /// The registered operators and their parameters.
+    List,
+}
+
+fn main() -> ExitCode {
+    match run(Cli::parse()) {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(message) => {
+            eprintln!("covtrace: {message}");
+            ExitCode::from(2)
+        }
+    }
+}
+
+fn run(cli: Cli) -> Result<(), String> {
+    let registry = covtrace::registry();
+    match cli.command {
+        Command::Eval { path, json } => {
+            let p = Path::load(&path, &registry).map_err(|e| e.to_string())?;
+            let name = path.display().to_string();
+            let e = p.eval().map_err(|e| e.in_file(&name).to_string())?;
+            if json {
+                println!("{}", e.to_json());
+            } else {
+                print!("{}", format_evaluation(&name, &e));
+            }
+        }
+        Command::Plot { path, output } => {
+            let p = Path::load(&path, &registry).map_err(|e| e.to_string())?;
+            let name = path.display().to_string();
+            let e = p.eval().map_err(|e| e.in_file(&name).to_string())?;
+            let legend = plot::plot(&e, &output).map_err(|e| format!("{}: {e}", output.display()))?;
+            print!("{legend}");
+            println!("written to {}", output.display());
+        }
+        Command::Validate { full, output } => {
+            let sizes = report::sizes(full);
+            let total = report::cases().map_err(|e| e.to_string())?.len() * sizes.len();
+            let bar = ProgressBar::new(total as u64);
+            bar.set_style(
+                ProgressStyle::with_template("{bar:40} {pos}/{len} {msg} [{elapsed}]")
+                    .unwrap_or_else(|_| ProgressStyle::default_bar()),
+            );
+            println!("{}", report::header());
+            let rows = report::run(&sizes, |r| {
+                bar.println(report::line(r));
+                bar.set_message(r.case);
+                bar.inc(1);
+            })
+            .map_err(|e| e.to_string())?;
+            bar.finish_and_clear();
+            report::chart(&output, &rows).map_err(|e| format!("{output}: {e}"))?;
+            println!("chart written to {output}");
+        }
+        Command::List => {
+            for e in registry.entries() {
+                println!("{}: {}", e.name, e.summary);
+                if e.unit {
+                    println!("    (no parameters: write `{}`)", e.name);
+                }
+                for p in e.params {
+                    println!("    {:<10} {:<13} {}", p.name, p.unit, p.doc);
+                }
+            }
+        }
+    }
+    Ok(())
+}
