@@ -131,15 +131,18 @@ impl Lobe {
     /// # Errors
     /// Negative or non-finite parameters.
     pub fn validated(self) -> Result<Lobe, CovError> {
-        let (name, a, b) = match self {
+        let params: [(&str, &str, f64); 2] = match self {
             Lobe::Diffuse | Lobe::Mirror => return Ok(self),
-            Lobe::Phong { exponent } => ("Phong", exponent, 0.0),
-            Lobe::Gaussian { var_u, var_v } => ("Gaussian", var_u, var_v),
-            Lobe::Beckmann { alpha_u, alpha_v } => ("Beckmann", alpha_u, alpha_v),
-            Lobe::Ggx { alpha_u, alpha_v } => ("Ggx", alpha_u, alpha_v),
+            Lobe::Phong { exponent } => [("Phong", "exponent", exponent); 2],
+            Lobe::Gaussian { var_u, var_v } => [("Gaussian", "var_u", var_u), ("Gaussian", "var_v", var_v)],
+            Lobe::Beckmann { alpha_u, alpha_v } => {
+                [("Beckmann", "alpha_u", alpha_u), ("Beckmann", "alpha_v", alpha_v)]
+            }
+            Lobe::Ggx { alpha_u, alpha_v } => [("Ggx", "alpha_u", alpha_u), ("Ggx", "alpha_v", alpha_v)],
         };
-        CovError::check_non_negative(name, "first parameter", a)?;
-        CovError::check_non_negative(name, "second parameter", b)?;
+        for (op, name, v) in params {
+            CovError::check_non_negative(op, name, v)?;
+        }
         Ok(self)
     }
 

@@ -50,6 +50,14 @@ enum Command {
     List,
 }
 
+/// Prints a line; a closed pipe (`covtrace list | head`) is not an error.
+macro_rules! say {
+    ($($t:tt)*) => {{
+        use std::io::Write;
+        let _ = writeln!(std::io::stdout().lock(), $($t)*);
+    }};
+}
+
 fn main() -> ExitCode {
     match run(Cli::parse()) {
         Ok(()) => ExitCode::SUCCESS,
@@ -68,9 +76,9 @@ fn run(cli: Cli) -> Result<(), String> {
             let name = path.display().to_string();
             let e = p.eval().map_err(|e| e.in_file(&name).to_string())?;
             if json {
-                println!("{}", e.to_json());
+                say!("{}", e.to_json());
             } else {
-                print!("{}", format_evaluation(&name, &e));
+                say!("{}", format_evaluation(&name, &e).trim_end());
             }
         }
         Command::Plot { path, output } => {
@@ -78,8 +86,8 @@ fn run(cli: Cli) -> Result<(), String> {
             let name = path.display().to_string();
             let e = p.eval().map_err(|e| e.in_file(&name).to_string())?;
             let legend = plot::plot(&e, &output).map_err(|e| format!("{}: {e}", output.display()))?;
-            print!("{legend}");
-            println!("written to {}", output.display());
+            say!("{}", legend.trim_end());
+            say!("written to {}", output.display());
         }
         Command::Validate { full, output } => {
             let sizes = report::sizes(full);
@@ -89,7 +97,7 @@ fn run(cli: Cli) -> Result<(), String> {
                 ProgressStyle::with_template("{bar:40} {pos}/{len} {msg} [{elapsed}]")
                     .unwrap_or_else(|_| ProgressStyle::default_bar()),
             );
-            println!("{}", report::header());
+            say!("{}", report::header());
             let rows = report::run(&sizes, |r| {
                 bar.println(report::line(r));
                 bar.set_message(r.case);
@@ -98,16 +106,16 @@ fn run(cli: Cli) -> Result<(), String> {
             .map_err(|e| e.to_string())?;
             bar.finish_and_clear();
             report::chart(&output, &rows).map_err(|e| format!("{output}: {e}"))?;
-            println!("chart written to {output}");
+            say!("chart written to {output}");
         }
         Command::List => {
             for e in registry.entries() {
-                println!("{}: {}", e.name, e.summary);
+                say!("{}: {}", e.name, e.summary);
                 if e.unit {
-                    println!("    (no parameters: write `{}`)", e.name);
+                    say!("    (no parameters: write `{}`)", e.name);
                 }
                 for p in e.params {
-                    println!("    {:<10} {:<13} {}", p.name, p.unit, p.doc);
+                    say!("    {:<10} {:<13} {}", p.name, p.unit, p.doc);
                 }
             }
         }

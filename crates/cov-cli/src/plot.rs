@@ -43,8 +43,9 @@ pub fn plot(e: &Evaluation, out: &std::path::Path) -> Result<String, image::Imag
     let rows = count.div_ceil(PER_ROW);
     let mut img = RgbImage::from_pixel(cols * PANEL, rows * PANEL, Rgb([255, 255, 255]));
     let planes = planes(e.layout);
-    // One scale per plane: the largest bandwidth on either of its axes over all steps.
-    let scales: Vec<f64> = planes
+    // One scale per plane: the largest bandwidth on either of its axes over all steps;
+    // the (position, direction) planes share theirs, having the same units.
+    let mut scales: Vec<f64> = planes
         .iter()
         .map(|((a, b), _, _)| {
             mats.iter()
@@ -52,6 +53,17 @@ pub fn plot(e: &Evaluation, out: &std::path::Path) -> Result<String, image::Imag
                 .fold(0.0f64, f64::max)
         })
         .collect();
+    let time_axis = if e.layout == 3 { 2 } else { 4 };
+    let shared = planes
+        .iter()
+        .zip(&scales)
+        .filter(|(((_, b), _, _), _)| *b != time_axis || e.layout < 3)
+        .fold(0.0f64, |m, (_, s)| m.max(*s));
+    for (((_, b), _, _), s) in planes.iter().zip(scales.iter_mut()) {
+        if *b != time_axis || e.layout < 3 {
+            *s = shared;
+        }
+    }
     for (k, (_, m)) in mats.iter().enumerate() {
         let (ox, oy) = ((k as u32 % PER_ROW) * PANEL, (k as u32 / PER_ROW) * PANEL);
         // Frame and axes.

@@ -28,6 +28,7 @@
 
 mod path;
 mod registry;
+mod scan;
 
 pub use path::{EvalStep, Evaluation, Path, PathError, Source, ron_options};
 pub use registry::{DynOperator, Entry, OperatorSpec, Param, PathOperator, Registry};

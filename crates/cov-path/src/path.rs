@@ -26,11 +26,14 @@ pub enum PathError {
         /// What is wrong.
         message: String,
     },
-    /// A path that parsed but cannot be traced (layout mismatch, overflow …).
-    #[error("{file}: {message}")]
+    /// A path that parsed but cannot be traced (overflow, a layout the operators do not
+    /// fit …), with the position of the step when it is known.
+    #[error("{file}:{}{message}", at.map(|(l, c)| format!("{l}:{c}: ")).unwrap_or_else(|| " ".into()))]
     Eval {
         /// File name (or `<string>`).
         file: String,
+        /// Line and column of the failing step.
+        at: Option<(usize, usize)>,
         /// What is wrong.
         message: String,
     },
@@ -48,6 +51,15 @@ impl PathError {
     fn eval(message: impl Into<String>) -> Self {
         PathError::Eval {
             file: "<string>".into(),
+            at: None,
+            message: message.into(),
+        }
+    }
+
+    fn eval_at(at: Option<(usize, usize)>, message: impl Into<String>) -> Self {
+        PathError::Eval {
+            file: "<string>".into(),
+            at,
             message: message.into(),
         }
     }
@@ -63,8 +75,9 @@ impl PathError {
                 col,
                 message,
             },
-            PathError::Eval { message, .. } => PathError::Eval {
+            PathError::Eval { message, at, .. } => PathError::Eval {
                 file: name.into(),
+                at,
                 message,
             },
             PathError::Io { message, .. } => PathError::Io {
@@ -145,6 +158,67 @@ impl Source {
         }
     }
 
+    /// Checks the values (and, when the layout is known, the axes) of the source.
+    ///
+    /// # Errors
+    /// A message naming the bad value.
+    pub fn check(&self, layout: Option<usize>) -> Result<(), String> {
+        match self {
+            Source::Gaussian { .. } => {
+                for (axis, std) in self.gaussian_stds().into_iter().flatten() {
+                    if let Some(s) = std
+                        && (s.is_nan() || s <= 0.0)
+                    {
+                        return Err(format!(
+                            "Gaussian source: std `{axis}` = {s} must be > 0 (inf: constant)"
+                        ));
+                    }
+                }
+            }
+            Source::Dirac {
+                scene_scale,
+                relative_size,
+            } => {
+                Cov::<2>::dirac(
+                    *scene_scale,
+                    relative_size.unwrap_or(cov_core::DIRAC_RELATIVE_SIZE),
+                )
+                .map_err(|e| format!("Dirac source: {e}"))?;
+            }
+            Source::Matrix { rows } => {
+                let n = rows.len();
+                if !(2..=5).contains(&n) || rows.iter().any(|r| r.len() != n) {
+                    return Err(format!(
+                        "Matrix source: expected N rows of N numbers with N in 2..=5, got {n} rows of lengths {:?}",
+                        rows.iter().map(Vec::len).collect::<Vec<_>>()
+                    ));
+                }
+                let checked = match n {
+                    2 => self.covariance::<2>().map(|_| ()),
+                    3 => self.covariance::<3>().map(|_| ()),
+                    4 => self.covariance::<4>().map(|_| ()),
+                    _ => self.covariance::<5>().map(|_| ()),
+                };
+                checked.map_err(|e| format!("Matrix source: {e}"))?;
+                if let Some(l) = layout
+                    && l != n
+                {
+                    return Err(format!("the source matrix is {n}×{n} but the layout is {l}"));
+                }
+            }
+        }
+        if let Some(n) = layout {
+            let have = layout_set(n);
+            if let Some(axis) = self.requires().iter().find(|a| !have.contains(*a)) {
+                return Err(format!(
+                    "the source needs axis `{axis}`, which layout {n} ({}) does not have",
+                    axes_string(n)
+                ));
+            }
+        }
+        Ok(())
+    }
+
     /// Σ of the source in layout `N`.
     ///
     /// # Errors
@@ -197,6 +271,8 @@ pub struct Path {
     pub source: Source,
     /// The operators, in order.
     pub operators: Vec<DynOperator>,
+    /// Line and column of each operator in the text (empty when not known).
+    pub positions: Vec<(usize, usize)>,
 }
 
 /// The options every path file is read with: `Some` may be left out, and a newtype
@@ -212,14 +288,22 @@ impl Path {
     /// # Errors
     /// [`PathError::Parse`] with the line and column of the problem.
     pub fn parse(text: &str, registry: &Registry) -> Result<Path, PathError> {
-        ron_options()
-            .from_str_seed(text, PathSeed { registry })
+        // First pass: the declared layout, wherever it stands in the file, so that the
+        // second pass can check every operator against it where it is written.
+        let declared = ron_options().from_str_seed(text, LayoutProbe).ok().flatten();
+        let mut path = ron_options()
+            .from_str_seed(text, PathSeed { registry, declared })
             .map_err(|e| PathError::Parse {
                 file: "<string>".into(),
                 line: e.span.start.line,
                 col: e.span.start.col,
                 message: e.code.to_string(),
-            })
+            })?;
+        let positions = crate::scan::operator_positions(text);
+        if positions.len() == path.operators.len() {
+            path.positions = positions;
+        }
+        Ok(path)
     }
 
     /// Reads and parses a file.
@@ -265,11 +349,14 @@ impl Path {
                 for (i, op) in self.operators.iter().enumerate() {
                     let req = Operator::<5>::requires(op);
                     if let Some(axis) = req.iter().find(|a| !have.contains(*a)) {
-                        return Err(PathError::eval(format!(
-                            "step {i} ({}) needs axis `{axis}`, which layout {n} ({}) does not have",
-                            Operator::<5>::name(op),
-                            axes_string(n)
-                        )));
+                        return Err(PathError::eval_at(
+                            self.positions.get(i).copied(),
+                            format!(
+                                "step {i} ({}) needs axis `{axis}`, which layout {n} ({}) does not have",
+                                Operator::<5>::name(op),
+                                axes_string(n)
+                            ),
+                        ));
                     }
                 }
                 if let Some(axis) = self.source.requires().iter().find(|a| !have.contains(*a)) {
@@ -311,10 +398,13 @@ impl Path {
             .source
             .covariance::<N>()
             .map_err(|e| PathError::eval(format!("source: {e}")))?;
-        let trace = self
-            .chain::<N>()
-            .trace(start)
-            .map_err(|e| PathError::eval(e.to_string()))?;
+        let trace = self.chain::<N>().trace(start).map_err(|e| {
+            let at = match &e {
+                CovError::Step { index, .. } => self.positions.get(*index).copied(),
+                _ => None,
+            };
+            PathError::eval_at(at, e.to_string())
+        })?;
         let to_rows =
             |c: &Cov<N>| -> Vec<Vec<f64>> { (0..N).map(|i| (0..N).map(|j| c.get(i, j)).collect()).collect() };
         Ok(Evaluation {
@@ -428,6 +518,35 @@ impl Visitor<'_> for Ident {
 
 struct PathSeed<'r> {
     registry: &'r Registry,
+    declared: Option<usize>,
+}
+
+/// First pass: reads `layout` only.
+struct LayoutProbe;
+
+impl<'de> DeserializeSeed<'de> for LayoutProbe {
+    type Value = Option<usize>;
+    fn deserialize<D: Deserializer<'de>>(self, d: D) -> Result<Option<usize>, D::Error> {
+        d.deserialize_struct("Path", FIELDS, self)
+    }
+}
+
+impl<'de> Visitor<'de> for LayoutProbe {
+    type Value = Option<usize>;
+    fn expecting(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str("a path")
+    }
+    fn visit_map<A: MapAccess<'de>>(self, mut map: A) -> Result<Option<usize>, A::Error> {
+        let mut layout = None;
+        while let Some(key) = map.next_key_seed(Ident)? {
+            if key == "layout" {
+                layout = Some(map.next_value::<usize>()?);
+            } else {
+                map.next_value::<de::IgnoredAny>()?;
+            }
+        }
+        Ok(layout.filter(|n| (2..=5).contains(n)))
+    }
 }
 
 const FIELDS: &[&str] = &["layout", "source", "operators"];
@@ -468,7 +587,9 @@ impl<'de> Visitor<'de> for PathSeed<'_> {
                     if source.is_some() {
                         return Err(de::Error::duplicate_field("source"));
                     }
-                    source = Some(map.next_value()?);
+                    let s: Source = map.next_value()?;
+                    s.check(layout.or(self.declared)).map_err(de::Error::custom)?;
+                    source = Some(s);
                 }
                 "operators" => {
                     if operators.is_some() {
@@ -476,7 +597,7 @@ impl<'de> Visitor<'de> for PathSeed<'_> {
                     }
                     operators = Some(map.next_value_seed(OpsSeed {
                         registry: self.registry,
-                        layout,
+                        layout: layout.or(self.declared),
                     })?);
                 }
                 other => return Err(de::Error::unknown_field(other, FIELDS)),
@@ -491,6 +612,7 @@ impl<'de> Visitor<'de> for PathSeed<'_> {
             layout,
             source,
             operators,
+            positions: Vec::new(),
         })
     }
 }
@@ -585,6 +707,14 @@ impl<'de> DeserializeSeed<'de> for EntrySeed<'_> {
     type Value = std::sync::Arc<dyn crate::PathOperator>;
     fn deserialize<D: Deserializer<'de>>(self, d: D) -> Result<Self::Value, D::Error> {
         let mut erased = <dyn erased_serde::Deserializer>::erase(d);
-        (self.entry.build)(&mut erased).map_err(|e| de::Error::custom(format!("{}: {e}", self.entry.name)))
+        let name = self.entry.name;
+        (self.entry.build)(&mut erased).map_err(|e| {
+            let msg = e.to_string();
+            if msg.starts_with(&format!("{name}: ")) {
+                de::Error::custom(msg)
+            } else {
+                de::Error::custom(format!("{name}: {msg}"))
+            }
+        })
     }
 }

@@ -1,0 +1,81 @@
+//! Every bundled path evaluates; `eval --json` reads back into the library; `plot` writes
+//! a PNG; `list` names every operator.
+
+use std::path::PathBuf;
+use std::process::Command;
+
+use covtrace::path::Evaluation;
+
+fn paths() -> Vec<PathBuf> {
+    let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../examples/paths");
+    let mut v: Vec<PathBuf> = std::fs::read_dir(dir)
+        .expect("examples/paths")
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| p.extension().is_some_and(|x| x == "ron"))
+        .collect();
+    v.sort();
+    assert!(v.len() >= 10, "bundled paths: {v:?}");
+    v
+}
+
+fn covtrace(args: &[&str]) -> std::process::Output {
+    Command::new(env!("CARGO_BIN_EXE_covtrace"))
+        .args(args)
+        .output()
+        .expect("run covtrace")
+}
+
+#[test]
+fn every_bundled_path_evaluates_and_round_trips_json() {
+    for p in paths() {
+        let ps = p.to_str().expect("utf-8 path");
+        let out = covtrace(&["eval", ps]);
+        assert!(
+            out.status.success(),
+            "{ps}: {}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let out = covtrace(&["eval", "--json", ps]);
+        assert!(out.status.success(), "{ps}");
+        let e = Evaluation::from_json(&String::from_utf8_lossy(&out.stdout)).expect("JSON reads back");
+        // The JSON result is the library's result, to the last bit.
+        let direct = covtrace::path::Path::load(&p, &covtrace::registry())
+            .and_then(|x| x.eval())
+            .expect("eval");
+        assert_eq!(e, direct, "{ps}");
+        match e.layout {
+            2 => drop(e.result_cov::<2>().expect("valid Σ")),
+            3 => drop(e.result_cov::<3>().expect("valid Σ")),
+            4 => drop(e.result_cov::<4>().expect("valid Σ")),
+            _ => drop(e.result_cov::<5>().expect("valid Σ")),
+        }
+    }
+}
+
+#[test]
+fn plot_writes_a_png() {
+    let dir = std::env::temp_dir().join(format!("covtrace-plot-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).expect("temp dir");
+    let out_png = dir.join("demo.png");
+    let demo = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../examples/paths/demo.ron");
+    let out = covtrace(&[
+        "plot",
+        demo.to_str().expect("utf-8"),
+        "-o",
+        out_png.to_str().expect("utf-8"),
+    ]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let bytes = std::fs::read(&out_png).expect("png written");
+    assert_eq!(&bytes[1..4], b"PNG");
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+#[test]
+fn list_names_every_registered_operator() {
+    let out = covtrace(&["list"]);
+    assert!(out.status.success());
+    let text = String::from_utf8_lossy(&out.stdout);
+    for e in covtrace::registry().entries() {
+        assert!(text.contains(&format!("{}:", e.name)), "{}", e.name);
+    }
+}
