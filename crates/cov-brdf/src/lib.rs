@@ -46,6 +46,26 @@
 //! # Ok::<(), cov_core::CovError>(())
 //! ```
 
+//!
+//! **In a RON path** (Brdf, Reflect; register with [`spec::register`]):
+//!
+//! ```
+//! let mut registry = cov_path::Registry::new();
+//! cov_brdf::spec::register(&mut registry);
+//! let text = r#"
+//! Path(
+//!     source: Gaussian(x: 0.1),
+//!     operators: [
+//!         Brdf(lobe: Ggx(alpha_u: 0.2, alpha_v: 0.2)),
+//!         Reflect(cos_in: 0.8, cos_out: 0.8, curvature: (k: 2.0), lobe: Phong(exponent: 200)),
+//!     ],
+//! )
+//! "#;
+//! let path = cov_path::Path::parse(text, &registry)?;
+//! let result = path.eval()?;
+//! assert_eq!(result.layout, 2); // inferred from what the operators need
+//! # Ok::<(), cov_path::PathError>(())
+//! ```
 #![warn(missing_docs)]
 
 pub mod spec;

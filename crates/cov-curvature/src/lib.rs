@@ -30,6 +30,23 @@
 //! # Ok::<(), cov_core::CovError>(())
 //! ```
 
+//!
+//! **In a RON path** (Curvature, CurvatureTensor; register with [`spec::register`]):
+//!
+//! ```
+//! let mut registry = cov_path::Registry::new();
+//! cov_curvature::spec::register(&mut registry);
+//! let text = r#"
+//! Path(
+//!     source: Gaussian(x: 0.02, y: 0.02),
+//!     operators: [Curvature(k: 2.0), Curvature(kx: 5.0, ky: -2.0, angle: 0.5), CurvatureTensor(kxx: 1.0, kxy: 0.1, kyy: 0.0)],
+//! )
+//! "#;
+//! let path = cov_path::Path::parse(text, &registry)?;
+//! let result = path.eval()?;
+//! assert_eq!(result.layout, 4); // inferred from what the operators need
+//! # Ok::<(), cov_path::PathError>(())
+//! ```
 #![warn(missing_docs)]
 
 pub mod spec;

@@ -28,6 +28,28 @@
 //! # Ok::<(), cov_core::CovError>(())
 //! ```
 
+//!
+//! **In a RON path** (Window, BlockerEdge, Texture, ThickOccluder; register with [`spec::register`]):
+//!
+//! ```
+//! let mut registry = cov_path::Registry::new();
+//! cov_occlusion::spec::register(&mut registry);
+//! let text = r#"
+//! Path(
+//!     source: Gaussian(x: 0.3, y: 0.3),
+//!     operators: [
+//!         Window(std_x: 0.05, std_y: 0.1),
+//!         BlockerEdge(distance: 0.02),
+//!         Texture(sxx: 400.0, sxy: 10.0, syy: 100.0),
+//!         ThickOccluder(depth: 0.3, slices: 3, std: 0.05),
+//!     ],
+//! )
+//! "#;
+//! let path = cov_path::Path::parse(text, &registry)?;
+//! let result = path.eval()?;
+//! assert_eq!(result.layout, 4); // inferred from what the operators need
+//! # Ok::<(), cov_path::PathError>(())
+//! ```
 #![warn(missing_docs)]
 
 pub mod spec;

@@ -130,6 +130,10 @@ pub trait OperatorSpec: DeserializeOwned + 'static {
     }
 }
 
+/// Builds a unit (parameterless) operator, `None` if the spec has no unit form.
+type BuildUnitFn = fn() -> Option<Result<Arc<dyn PathOperator>, CovError>>;
+
+/// Builds an operator from its parameters.
 type BuildFn =
     fn(&mut dyn erased_serde::Deserializer<'_>) -> Result<Arc<dyn PathOperator>, erased_serde::Error>;
 
@@ -145,7 +149,7 @@ pub struct Entry {
     /// Written as a bare name.
     pub unit: bool,
     pub(crate) build: BuildFn,
-    pub(crate) build_unit: fn() -> Option<Result<Arc<dyn PathOperator>, CovError>>,
+    pub(crate) build_unit: BuildUnitFn,
 }
 
 impl fmt::Debug for Entry {

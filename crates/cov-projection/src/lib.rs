@@ -38,6 +38,23 @@
 //! # Ok::<(), cov_core::CovError>(())
 //! ```
 
+//!
+//! **In a RON path** (Project, Unproject, Mirror, RotateFrame; register with [`spec::register`]):
+//!
+//! ```
+//! let mut registry = cov_path::Registry::new();
+//! cov_projection::spec::register(&mut registry);
+//! let text = r#"
+//! Path(
+//!     source: Gaussian(x: 0.05, y: 0.02, u: 0.1),
+//!     operators: [RotateFrame(angle: 0.4), Project(cos: 0.3), Mirror, Unproject(cos: 0.5, angle: -0.4)],
+//! )
+//! "#;
+//! let path = cov_path::Path::parse(text, &registry)?;
+//! let result = path.eval()?;
+//! assert_eq!(result.layout, 4); // inferred from what the operators need
+//! # Ok::<(), cov_path::PathError>(())
+//! ```
 #![warn(missing_docs)]
 
 pub mod spec;

@@ -33,6 +33,26 @@
 //! # Ok::<(), cov_core::CovError>(())
 //! ```
 
+//!
+//! **In a RON path** (Refract, RoughRefract; register with [`spec::register`]):
+//!
+//! ```
+//! let mut registry = cov_path::Registry::new();
+//! cov_refraction::spec::register(&mut registry);
+//! let text = r#"
+//! Path(
+//!     source: Gaussian(x: 0.02),
+//!     operators: [
+//!         Refract(n1: 1.0, n2: 1.5, cos_i: 0.8),
+//!         RoughRefract(n1: 1.5, n2: 1.0, cos_i: 0.9, lobe: Beckmann(alpha_u: 0.05, alpha_v: 0.05)),
+//!     ],
+//! )
+//! "#;
+//! let path = cov_path::Path::parse(text, &registry)?;
+//! let result = path.eval()?;
+//! assert_eq!(result.layout, 2); // inferred from what the operators need
+//! # Ok::<(), cov_path::PathError>(())
+//! ```
 #![warn(missing_docs)]
 
 pub mod spec;
