@@ -52,6 +52,12 @@ pub fn registry() -> cov_path::Registry {
     cov_brdf::spec::register(&mut r);
     #[cfg(feature = "refraction")]
     cov_refraction::spec::register(&mut r);
+    #[cfg(feature = "motion")]
+    cov_motion::spec::register(&mut r);
+    #[cfg(feature = "defocus")]
+    cov_defocus::spec::register(&mut r);
+    #[cfg(feature = "sensor")]
+    cov_sensor::spec::register(&mut r);
     r
 }
 
@@ -78,3 +84,16 @@ pub use cov_brdf as brdf;
 /// Refraction (crate `cov-refraction`, feature `refraction`).
 #[cfg(feature = "refraction")]
 pub use cov_refraction as refraction;
+
+/// Moving objects and cameras, shutters (crate `cov-motion`, feature `motion`).
+#[cfg(feature = "motion")]
+pub use cov_motion as motion;
+
+/// Thin lens and pinhole (crate `cov-defocus`, feature `defocus`).
+#[cfg(feature = "defocus")]
+pub use cov_defocus as defocus;
+
+/// Sensor decisions: pixel filter, density, reconstruction filter (crate `cov-sensor`,
+/// feature `sensor`).
+#[cfg(feature = "sensor")]
+pub use cov_sensor as sensor;

@@ -60,3 +60,33 @@ pub fn format_evaluation(name: &str, e: &Evaluation) -> String {
     }
     out
 }
+
+/// The per-pixel decisions as text.
+pub fn format_decisions(d: &covtrace::sensor::PixelDecisions) -> String {
+    let mut out = String::from("per pixel (sensor):\n");
+    out.push_str(&format!(
+        "  image bandwidth     {} cycles/px (axes {})\n",
+        d.image_bandwidth_px
+            .iter()
+            .map(|v| format!("{v:.4}"))
+            .collect::<Vec<_>>()
+            .join(", "),
+        d.image_axes.join(",")
+    ));
+    out.push_str(&format!(
+        "  filter std          {} px (principal axes){}\n",
+        d.filter_std_px
+            .iter()
+            .map(|v| format!("{v:.3}"))
+            .collect::<Vec<_>>()
+            .join(", "),
+        if d.filter_clamped { ", clamped" } else { "" }
+    ));
+    out.push_str(&format!("  sampled domain      {}\n", d.sampled_axes.join(" × ")));
+    out.push_str(&format!(
+        "  density             {:.4e} samples per unit volume\n",
+        d.density
+    ));
+    out.push_str(&format!("  samples per pixel   {:.3}\n", d.samples_per_pixel));
+    out
+}

@@ -68,6 +68,44 @@ fn main() -> ExitCode {
     }
 }
 
+/// The per-pixel decisions when the path ends at a `Sensor` (from Σ just before it).
+fn sensor_decisions(
+    p: &Path,
+    e: &covtrace::path::Evaluation,
+) -> Result<Option<covtrace::sensor::PixelDecisions>, String> {
+    let Some(last) = p.operators.last() else {
+        return Ok(None);
+    };
+    let Some(sensor) = last.0.as_any().downcast_ref::<covtrace::sensor::Sensor>() else {
+        return Ok(None);
+    };
+    let before = if e.steps.len() >= 2 {
+        &e.steps[e.steps.len() - 2].matrix
+    } else {
+        &e.start
+    };
+    sensor
+        .decisions_rows(before)
+        .map(Some)
+        .map_err(|err| err.to_string())
+}
+
+fn json_with_decisions(
+    e: &covtrace::path::Evaluation,
+    d: Option<&covtrace::sensor::PixelDecisions>,
+) -> String {
+    match d {
+        None => e.to_json(),
+        Some(d) => {
+            let mut v = serde_json::to_value(e).unwrap_or_default();
+            if let (Some(obj), Ok(dv)) = (v.as_object_mut(), serde_json::to_value(d)) {
+                obj.insert("pixel".into(), dv);
+            }
+            serde_json::to_string_pretty(&v).unwrap_or_default()
+        }
+    }
+}
+
 fn run(cli: Cli) -> Result<(), String> {
     let registry = covtrace::registry();
     match cli.command {
@@ -75,10 +113,14 @@ fn run(cli: Cli) -> Result<(), String> {
             let p = Path::load(&path, &registry).map_err(|e| e.to_string())?;
             let name = path.display().to_string();
             let e = p.eval().map_err(|e| e.in_file(&name).to_string())?;
+            let decisions = sensor_decisions(&p, &e).map_err(|m| format!("{name}: {m}"))?;
             if json {
-                say!("{}", e.to_json());
+                say!("{}", json_with_decisions(&e, decisions.as_ref()));
             } else {
                 say!("{}", format_evaluation(&name, &e).trim_end());
+                if let Some(d) = decisions {
+                    say!("\n{}", cov_cli::format_decisions(&d).trim_end());
+                }
             }
         }
         Command::Plot { path, output } => {
@@ -99,7 +141,11 @@ fn run(cli: Cli) -> Result<(), String> {
             );
             say!("{}", report::header());
             let rows = report::run(&sizes, |r| {
-                bar.println(report::line(r));
+                if bar.is_hidden() {
+                    say!("{}", report::line(r));
+                } else {
+                    bar.println(report::line(r));
+                }
                 bar.set_message(r.case);
                 bar.inc(1);
             })

@@ -18,6 +18,7 @@ use crate::CovError;
 /// Units: `X`, `Y` metres; `U`, `V` tangent of the angular offset (dimensionless);
 /// `T` seconds. Frequencies along an axis are in cycles per that unit.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "lowercase")]
 pub enum Axis {
     /// Horizontal position in the plane orthogonal to the ray (m).
     X,

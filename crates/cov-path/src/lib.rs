@@ -26,9 +26,11 @@
 
 #![warn(missing_docs)]
 
+mod nested;
 mod path;
 mod registry;
 mod scan;
 
+pub use nested::Operators;
 pub use path::{EvalStep, Evaluation, Path, PathError, Source, ron_options};
 pub use registry::{DynOperator, Entry, OperatorSpec, Param, PathOperator, Registry};

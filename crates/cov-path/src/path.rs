@@ -288,6 +288,9 @@ impl Path {
     /// # Errors
     /// [`PathError::Parse`] with the line and column of the problem.
     pub fn parse(text: &str, registry: &Registry) -> Result<Path, PathError> {
+        // Nested operator lists (`Moving(..., operators: [...])`) read the registry from
+        // this scope.
+        let _scope = crate::nested::RegistryScope::enter(registry);
         // First pass: the declared layout, wherever it stands in the file, so that the
         // second pass can check every operator against it where it is written.
         let declared = ron_options().from_str_seed(text, LayoutProbe).ok().flatten();
@@ -617,9 +620,9 @@ impl<'de> Visitor<'de> for PathSeed<'_> {
     }
 }
 
-struct OpsSeed<'r> {
-    registry: &'r Registry,
-    layout: Option<usize>,
+pub(crate) struct OpsSeed<'r> {
+    pub(crate) registry: &'r Registry,
+    pub(crate) layout: Option<usize>,
 }
 
 impl<'de> DeserializeSeed<'de> for OpsSeed<'_> {

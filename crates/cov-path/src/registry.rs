@@ -34,12 +34,18 @@ pub trait PathOperator: fmt::Debug + Send + Sync {
     /// # Errors
     /// As the operator.
     fn apply5(&self, c: &mut Cov<5>) -> Result<(), CovError>;
+    /// The concrete operator, for callers that look for a particular one (the CLI finds a
+    /// final `Sensor` this way).
+    fn as_any(&self) -> &dyn std::any::Any;
 }
 
 impl<T> PathOperator for T
 where
-    T: Operator<2> + Operator<3> + Operator<4> + Operator<5>,
+    T: Operator<2> + Operator<3> + Operator<4> + Operator<5> + 'static,
 {
+    fn as_any(&self) -> &dyn std::any::Any {
+        self
+    }
     fn op_name(&self) -> &str {
         Operator::<2>::name(self)
     }

@@ -1,0 +1,150 @@
+//! # cov-defocus: thin lens, aperture, pinhole
+//!
+//! **Primal definitions** (PHYSICS.md section 3): a thin lens of focal length `f` is a
+//! curvature of `1/f`, `l'(x,u) = l(x, u + x/f)`, followed by travel to the sensor; the
+//! aperture is a window on the lens position (rule 2); the sensor integrates over the
+//! lens (rule 4, done by cov-sensor). The sensor sits where the focus plane is imaged:
+//! `d_s = f·d_f / (d_f − f)` (thin-lens equation), so a point at distance `d_f` in front
+//! of the lens lands on one sensor point whatever the aperture (tested: no defocus term).
+//!
+//! The **pinhole** is the limit of a vanishing aperture, computed in closed form instead of
+//! with an infinite window: the sensor at `d_s` sees `L(x_s) = l(0, x_s/d_s)`, rule 1 with
+//! the singular map `(x, u) ↦ (0, x/d_s)`, i.e. `Σ'_xx = Σ_uu / d_s²` and nothing left in
+//! angle. No NaN, no infinity.
+//!
+//! | operator | parameter | unit | domain | meaning |
+//! |---|---|---|---|---|
+//! | [`ThinLens`] | `focal_length` | m | > 0 | `f` |
+//! | [`ThinLens`] | `aperture` | m | > 0 | std of the Gaussian aperture (a disk of radius `R`: `R/2`, equal variance) |
+//! | [`ThinLens`] | `focus_distance` | m | > `f` | distance of the plane in focus |
+//! | [`Pinhole`] | `sensor_distance` | m | > 0 | pinhole to sensor |
+//!
+//! **Worked example**: `f = 50 mm`, focus at `2 m` → `d_s = 0.05·2/1.95 = 51.28 mm`. A point
+//! at 1 m (out of focus) is imaged at `d_i = 52.63 mm`; on the sensor its rays spread over
+//! `aperture × |1 − d_s/d_i| = 5 mm × 0.0256 = 0.128 mm` (std), the defocus blur that the
+//! validator measures (`tests/validate.rs`).
+//!
+//! ```
+//! use cov_core::{Axis, Cov, Operator};
+//! use cov_defocus::ThinLens;
+//!
+//! let lens = ThinLens::new(0.05, 0.005, 2.0)?;
+//! assert!((lens.sensor_distance() - 0.05 * 2.0 / 1.95).abs() < 1e-15);
+//! let mut c = Cov::<2>::zeros();
+//! Operator::<2>::apply(&lens, &mut c)?;
+//! assert!(c.validity().is_valid());
+//! # Ok::<(), cov_core::CovError>(())
+//! ```
+//!
+//! In RON:
+//!
+//! ```
+//! let mut registry = cov_path::Registry::new();
+//! cov_defocus::spec::register(&mut registry);
+//! let text = "Path(source: Gaussian(x: 0.01), operators: [ThinLens(focal_length: 0.05, aperture: 0.005, focus_distance: 2.0)])";
+//! let result = cov_path::Path::parse(text, &registry)?.eval()?;
+//! assert_eq!(result.layout, 2);
+//! # Ok::<(), cov_path::PathError>(())
+//! ```
+
+#![warn(missing_docs)]
+
+pub mod spec;
+
+use cov_core::{Cov, CovError, FOUR_PI_SQ, Operator};
+
+/// A thin lens with a Gaussian aperture, focused at `focus_distance`; ends at the sensor.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ThinLens {
+    f: f64,
+    aperture: f64,
+    d_s: f64,
+}
+
+impl ThinLens {
+    /// Operator name.
+    pub const NAME: &'static str = "ThinLens";
+
+    /// # Errors
+    /// Non-positive or non-finite parameters, or `focus_distance ≤ focal_length` (no real
+    /// image).
+    pub fn new(focal_length: f64, aperture: f64, focus_distance: f64) -> Result<Self, CovError> {
+        CovError::check_positive(Self::NAME, "focal_length", focal_length)?;
+        CovError::check_positive(Self::NAME, "aperture", aperture)?;
+        CovError::check_range(
+            Self::NAME,
+            "focus_distance",
+            focus_distance,
+            |d| d > focal_length,
+            &format!("must be > focal_length = {focal_length} (a real image)"),
+        )?;
+        let d_s = focal_length * focus_distance / (focus_distance - focal_length);
+        CovError::check_finite(Self::NAME, "sensor distance", d_s)?;
+        Ok(ThinLens {
+            f: focal_length,
+            aperture,
+            d_s,
+        })
+    }
+
+    /// Lens-to-sensor distance `d_s` (m).
+    pub fn sensor_distance(&self) -> f64 {
+        self.d_s
+    }
+
+    /// Aperture std (m).
+    pub fn aperture(&self) -> f64 {
+        self.aperture
+    }
+}
+
+impl<const N: usize> Operator<N> for ThinLens {
+    fn apply(&self, cov: &mut Cov<N>) -> Result<(), CovError> {
+        let w = 1.0 / (FOUR_PI_SQ * self.aperture * self.aperture);
+        for &(x, u) in Cov::<N>::transverse_pairs() {
+            cov.add_variance(x, w)?;
+            cov.shear(u, x, 1.0 / self.f)?;
+            cov.shear(x, u, -self.d_s)?;
+        }
+        Ok(())
+    }
+    fn name(&self) -> &str {
+        Self::NAME
+    }
+}
+
+/// A pinhole camera: the sensor at `sensor_distance` behind an infinitely small hole.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Pinhole {
+    d_s: f64,
+}
+
+impl Pinhole {
+    /// Operator name.
+    pub const NAME: &'static str = "Pinhole";
+
+    /// # Errors
+    /// Non-positive or non-finite distance.
+    pub fn new(sensor_distance: f64) -> Result<Self, CovError> {
+        Ok(Pinhole {
+            d_s: CovError::check_positive(Self::NAME, "sensor_distance", sensor_distance)?,
+        })
+    }
+}
+
+impl<const N: usize> Operator<N> for Pinhole {
+    fn apply(&self, cov: &mut Cov<N>) -> Result<(), CovError> {
+        // (x, u) ↦ (0, x/d_s) on each pair; time untouched.
+        let mut a = nalgebra::SMatrix::<f64, N, N>::identity();
+        for &(x, u) in Cov::<N>::transverse_pairs() {
+            let (ix, iu) = (Cov::<N>::index(x)?, Cov::<N>::index(u)?);
+            a[(ix, ix)] = 0.0;
+            a[(iu, iu)] = 0.0;
+            a[(iu, ix)] = 1.0 / self.d_s;
+        }
+        cov.congruence(&a)
+    }
+    fn name(&self) -> &str {
+        Self::NAME
+    }
+}
