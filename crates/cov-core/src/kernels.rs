@@ -11,6 +11,12 @@ use nalgebra::SMatrix;
 use crate::linalg::{MAX, Small, psd_pinv, sym_eigen};
 use crate::{Axis, Cov, CovError, PSD_RTOL};
 
+/// Relative level below which a diagonal entry of a Schur complement is rounding noise
+/// (dimensionless, relative to the same entry before the update): `64 ε ≈ 1.4e-14`.
+/// Cancellation in `Σ_aa − Σ_ap Σ_pp⁻¹ Σ_pa` leaves an error of a few ε × `Σ_aa`; what
+/// remains below `64 ε` is not information. See `Cov::convolve` and `Cov::integrate`.
+pub const SCHUR_SNAP: f64 = 64.0 * f64::EPSILON;
+
 impl<const N: usize> Cov<N> {
     /// The (position, direction) axis pairs of this layout: `[(x, u)]` in flatland,
     /// `[(x, u), (y, v)]` in 3D. Flatland operator definitions apply to each pair.
@@ -277,6 +283,10 @@ impl<const N: usize> Cov<N> {
             self.lobe_product_1(p[0], s[0][0]);
             return;
         }
+        let mut before = [0.0; N];
+        for (i, b) in before.iter_mut().enumerate() {
+            *b = self.get(i, i);
+        }
         let mut m = [[0.0; MAX]; MAX];
         for a in 0..k {
             for b in 0..k {
@@ -328,6 +338,7 @@ impl<const N: usize> Cov<N> {
                 self.set(p[a], p[b], 0.5 * (ab + ba));
             }
         }
+        self.snap_cancelled(&before);
     }
 
     /// One convolved axis `p` with lobe spectrum `s ≥ 0` (the common case: a lobe on u,
@@ -337,6 +348,10 @@ impl<const N: usize> Cov<N> {
     /// generalised inverse is 0 and only the axis itself is cleared.
     #[inline]
     fn lobe_product_1(&mut self, p: usize, s: f64) {
+        let mut before = [0.0; N];
+        for (i, b) in before.iter_mut().enumerate() {
+            *b = self.get(i, i);
+        }
         let spp = self.get(p, p);
         let m = s + spp;
         let (inv, t) = if m > 0.0 { (1.0 / m, s / m) } else { (0.0, 0.0) };
@@ -358,6 +373,25 @@ impl<const N: usize> Cov<N> {
             self.set(a, p, col[a] * t);
         }
         self.set(p, p, spp * t);
+        self.snap_cancelled(&before);
+    }
+
+    /// Scale-aware clean-up after a Schur complement: a diagonal entry that cancelled to
+    /// at most [`SCHUR_SNAP`] times its value before the update holds nothing but rounding
+    /// noise (f64 cannot resolve it), and may even be slightly negative. It is set to 0
+    /// with its row and column, which keeps Σ exactly PSD-consistent. This is what makes
+    /// a point light seen through a diffuse bounce exactly smooth (Σ_xx = 0), and a
+    /// rank-deficient Σ through a diffuse lobe exactly 0, instead of ±1e-16 noise that
+    /// later travel would amplify.
+    fn snap_cancelled(&mut self, before: &[f64; N]) {
+        for a in 0..N {
+            let v = self.get(a, a);
+            if before[a] > 0.0 && v <= SCHUR_SNAP * before[a] {
+                for b in 0..N {
+                    self.set(a, b, 0.0);
+                }
+            }
+        }
     }
 
     fn resolve(&self, op: &str, axes: &[Axis]) -> Result<([usize; MAX], usize), CovError> {

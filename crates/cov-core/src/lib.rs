@@ -41,8 +41,8 @@
 //! ```
 //! use cov_core::{Axis, Cov, CovError};
 //!
-//! // A Gaussian spot of 1 mm std, lit uniformly from all directions.
-//! let mut c = Cov::<2>::gaussian([1e-3, f64::INFINITY])?;
+//! // A Gaussian spot of 1 mm std emitting into a cone of std 0.05 (tangent).
+//! let mut c = Cov::<2>::gaussian([1e-3, 0.05])?;
 //! c.shear(Axis::X, Axis::U, -0.5)?; // travel 0.5 m
 //! c.convolve(&[Axis::U], &[100.0])?; // a glossy lobe
 //! let image = c.integrated(&[Axis::X])?; // what a sensor integrating over angle sees
@@ -55,7 +55,7 @@
 mod axis;
 mod cov;
 mod error;
-mod kernels;
+pub mod kernels;
 pub mod linalg;
 mod operator;
 mod query;
@@ -63,5 +63,6 @@ mod query;
 pub use axis::{Axis, AxisSet, axis_index, layout_axes, layout_set};
 pub use cov::{Cov, DIRAC_RELATIVE_SIZE, FOUR_PI_SQ, PSD_RTOL, Validity};
 pub use error::CovError;
+pub use kernels::SCHUR_SNAP;
 pub use operator::{Chain, Operator, Step, Trace, check_layout};
 pub use query::{CovBlock, Filter, NYQUIST_K, primal_std_of_spectrum};

@@ -1,0 +1,583 @@
+//! # cov-stiff: numerical stability on stiff and extreme cases
+//!
+//! A suite of chains at the extremes (grazing incidence to `cos = 1e-12`, distances and
+//! curvatures from `1e-9` to `1e9`, Phong exponents from 1 to `1e12` and zero roughness,
+//! refraction a hair above the critical angle, a Dirac source, chains of `10⁴` operators,
+//! rank-deficient Σ, entries from `1e-300` to `1e300`), each evaluated three ways:
+//!
+//! - **ours**: the operator crates on `Cov<N>` (packed kernels, stable forms);
+//! - **plain**: the textbook formulas in dense f64 with nalgebra (`AᵀΣA`, and for lobes
+//!   `Σ − ΣPᵀ(S + PΣPᵀ)⁻¹PΣ` with `try_inverse`), as a straightforward implementation
+//!   would write them;
+//! - **reference**: the same textbook formulas in double-double arithmetic (twofloat,
+//!   about 32 significant digits), which is exact to far below f64 for these chains.
+//!
+//! [`run`] reports, per case, the relative error of ours and of plain against the
+//! reference (the larger of the Frobenius error and the error after scaling every axis
+//! by the reference's own bandwidth, so a small block is not hidden by a large one), PSD
+//! violations and failures. `covtrace stiff` prints it.
+
+#![warn(missing_docs)]
+
+pub mod reference;
+
+use std::f64::consts::PI;
+
+use cov_brdf::{Brdf, Lobe};
+use cov_core::{Chain, Cov, CovError};
+use cov_curvature::Curvature;
+use cov_projection::{Project, Unproject};
+use cov_refraction::Refract;
+use cov_travel::Travel;
+use nalgebra::DMatrix;
+use reference::{Dense, Real};
+use twofloat::TwoFloat;
+
+/// One event of a stiff chain.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum StiffOp {
+    /// Travel (m).
+    Travel(f64),
+    /// Curvature: principal `kx`, `ky` (1/m), angle (rad).
+    Curvature(f64, f64, f64),
+    /// Projection with `|cos θ|`.
+    Project(f64),
+    /// Inverse projection with `|cos θ|`.
+    Unproject(f64),
+    /// Phong lobe of the given exponent (`f64::INFINITY`: mirror).
+    Phong(f64),
+    /// Diffuse lobe.
+    Diffuse,
+    /// Smooth refraction `n1 → n2` at `cos_i`.
+    Refract(f64, f64, f64),
+}
+
+/// A stiff case.
+#[derive(Clone, Debug)]
+pub struct Case {
+    /// Name in the report.
+    pub name: String,
+    /// Layout: 2 or 4.
+    pub n: usize,
+    /// Σ at the start, row-major.
+    pub start: Vec<f64>,
+    /// The chain.
+    pub ops: Vec<StiffOp>,
+    /// Whether the exact answer is well conditioned (the ≤ 1e-9 target applies).
+    pub well_posed: bool,
+    /// The answer is undefined (e.g. total internal reflection): a typed error is right.
+    pub expect_error: bool,
+}
+
+/// Result of one case.
+#[derive(Clone, Debug)]
+pub struct Outcome {
+    /// Case name.
+    pub name: String,
+    /// Number of operators.
+    pub ops: usize,
+    /// Whether the 1e-9 target applies.
+    pub well_posed: bool,
+    /// A typed error is the right answer.
+    pub expect_error: bool,
+    /// Relative error of ours against the reference (`None`: ours returned an error).
+    pub ours: Option<f64>,
+    /// Ours returned a non-PSD Σ.
+    pub ours_non_psd: bool,
+    /// Ours' error message, if it failed.
+    pub ours_error: Option<String>,
+    /// Relative error of the plain implementation (`None`: it failed: NaN, inf or a
+    /// singular inverse).
+    pub plain: Option<f64>,
+    /// The plain result was not PSD.
+    pub plain_non_psd: bool,
+}
+
+fn phong_s(e: f64) -> f64 {
+    e / (4.0 * PI * PI)
+}
+
+fn op_matrix(op: StiffOp, n: usize) -> Option<Vec<f64>> {
+    let mut a = vec![0.0; n * n];
+    for i in 0..n {
+        a[i * n + i] = 1.0;
+    }
+    let pairs: &[(usize, usize)] = if n == 4 { &[(0, 2), (1, 3)] } else { &[(0, 1)] };
+    match op {
+        StiffOp::Travel(d) => {
+            for &(x, u) in pairs {
+                a[x * n + u] = -d;
+            }
+        }
+        StiffOp::Curvature(kx, ky, ang) => {
+            let (s, c) = ang.sin_cos();
+            let (kxx, kxy, kyy) = (
+                c * c * kx + s * s * ky,
+                c * s * (kx - ky),
+                s * s * kx + c * c * ky,
+            );
+            if n == 4 {
+                a[2 * n] = kxx;
+                a[2 * n + 1] = kxy;
+                a[3 * n] = kxy;
+                a[3 * n + 1] = kyy;
+            } else {
+                a[n] = kx;
+            }
+        }
+        StiffOp::Project(c) => a[0] = c,
+        StiffOp::Unproject(c) => a[0] = 1.0 / c,
+        StiffOp::Refract(n1, n2, ci) => {
+            let r = Refract::new(n1, n2, ci).ok()?;
+            let ui = if n == 4 { 2 } else { 1 };
+            a[0] = ci / r.cos_t();
+            a[ui * n + ui] = 1.0 / r.angular_scale();
+            if n == 4 {
+                a[3 * n + 3] = n2 / n1;
+            }
+        }
+        StiffOp::Phong(_) | StiffOp::Diffuse => return None,
+    }
+    Some(a)
+}
+
+fn lobe_axes(n: usize) -> &'static [usize] {
+    if n == 4 { &[2, 3] } else { &[1] }
+}
+
+fn lobe_s(op: StiffOp) -> Option<f64> {
+    match op {
+        StiffOp::Phong(e) if e.is_infinite() => None,
+        StiffOp::Phong(e) => Some(phong_s(e)),
+        StiffOp::Diffuse => Some(0.0),
+        _ => None,
+    }
+}
+
+/// The chain in the textbook formulas, in the real type `R`.
+pub fn dense_eval<R: Real>(case: &Case) -> Dense<R> {
+    dense_eval_peak(case).0
+}
+
+/// [`dense_eval`] and, per axis, the largest diagonal entry met along the chain.
+pub fn dense_eval_peak<R: Real>(case: &Case) -> (Dense<R>, Vec<f64>) {
+    let mut d = Dense::<R>::from_f64(case.n, &case.start);
+    let mut peak: Vec<f64> = (0..case.n).map(|i| d.at(i, i).to()).collect();
+    for &op in &case.ops {
+        if let Some(a) = op_matrix(op, case.n) {
+            d.congruence(&a);
+        } else if let Some(s) = lobe_s(op) {
+            for &p in lobe_axes(case.n) {
+                d.lobe(p, s);
+            }
+        }
+        for (i, pk) in peak.iter_mut().enumerate() {
+            *pk = pk.max(d.at(i, i).to());
+        }
+    }
+    (d, peak)
+}
+
+/// The same formulas in plain dense f64 with nalgebra (`None` when an inverse fails or a
+/// value is not finite).
+pub fn plain_eval(case: &Case) -> Option<DMatrix<f64>> {
+    let n = case.n;
+    let mut s = DMatrix::from_row_slice(n, n, &case.start);
+    for &op in &case.ops {
+        if let Some(a) = op_matrix(op, n) {
+            let a = DMatrix::from_row_slice(n, n, &a);
+            s = a.transpose() * &s * a;
+        } else if let Some(sl) = lobe_s(op) {
+            let axes = lobe_axes(n);
+            let k = axes.len();
+            let mut p = DMatrix::zeros(k, n);
+            for (r, &ax) in axes.iter().enumerate() {
+                p[(r, ax)] = 1.0;
+            }
+            let inner = DMatrix::identity(k, k) * sl + &p * &s * p.transpose();
+            let inv = inner.try_inverse()?;
+            s = &s - &s * p.transpose() * inv * &p * &s;
+        }
+        if s.iter().any(|v| !v.is_finite()) {
+            return None;
+        }
+    }
+    Some(s)
+}
+
+/// The chain through the operator crates.
+///
+/// # Errors
+/// An operator's error (e.g. overflow, total internal reflection).
+pub fn ours_eval(case: &Case) -> Result<DMatrix<f64>, CovError> {
+    match case.n {
+        2 => ours_n::<2>(case),
+        _ => ours_n::<4>(case),
+    }
+}
+
+fn ours_n<const N: usize>(case: &Case) -> Result<DMatrix<f64>, CovError> {
+    let m = nalgebra::SMatrix::<f64, N, N>::from_fn(|i, j| case.start[i * N + j]);
+    let start = Cov::<N>::from_matrix(&m)?;
+    let mut chain = Chain::<N>::new();
+    for &op in &case.ops {
+        match op {
+            StiffOp::Travel(d) => chain.push(Travel::new(d)?),
+            StiffOp::Curvature(kx, ky, a) => chain.push(Curvature::anisotropic(kx, ky, a)?),
+            StiffOp::Project(c) => chain.push(Project::new(c)?),
+            StiffOp::Unproject(c) => chain.push(Unproject::new(c)?),
+            StiffOp::Phong(e) if e.is_infinite() => chain.push(Brdf::new(Lobe::Mirror)?),
+            StiffOp::Phong(e) => chain.push(Brdf::new(Lobe::phong(e)?)?),
+            StiffOp::Diffuse => chain.push(Brdf::new(Lobe::Diffuse)?),
+            StiffOp::Refract(n1, n2, c) => chain.push(Refract::new(n1, n2, c)?),
+        }
+    }
+    let c = chain.eval(start)?;
+    if !c.validity().psd {
+        return Err(CovError::NotPsd {
+            min_eigenvalue: c.validity().min_eigenvalue,
+            tolerance: -c.validity().tolerance,
+        });
+    }
+    Ok(DMatrix::from_fn(N, N, |i, j| c.get(i, j)))
+}
+
+/// Resolution floor of the error measure (dimensionless): an axis whose exact value fell
+/// below `RESOLUTION × its peak along the chain` is compared at that level, since f64
+/// cannot represent it more finely than its history allows.
+pub const RESOLUTION: f64 = 1e-12;
+
+/// Relative error of `m` against `r`: the larger of the Frobenius error and the error
+/// after scaling each axis by the reference's bandwidth, floored at [`RESOLUTION`] × the
+/// axis' peak along the chain (`peak`), so that a small block is not hidden by a large one
+/// and an exactly cancelled one is judged at the precision f64 has there.
+pub fn rel_error(m: &DMatrix<f64>, r: &DMatrix<f64>, peak: &[f64]) -> f64 {
+    let n = r.nrows();
+    let scale_max = r.iter().fold(0.0f64, |a, v| a.max(v.abs()));
+    let peak_max = peak.iter().fold(0.0f64, |a, v| a.max(*v));
+    let denom = r.norm().max(RESOLUTION * peak_max);
+    let fro = if denom > 0.0 {
+        (m - r).norm() / denom
+    } else {
+        (m - r).norm()
+    };
+    let d: Vec<f64> = (0..n)
+        .map(|i| {
+            let floor = r[(i, i)].max(RESOLUTION * peak[i]);
+            if floor > 0.0 { 1.0 / floor.sqrt() } else { 0.0 }
+        })
+        .collect();
+    let mut worst: f64 = 0.0;
+    for i in 0..n {
+        for j in 0..n {
+            let diff = m[(i, j)] - r[(i, j)];
+            let e = if d[i] > 0.0 && d[j] > 0.0 {
+                (diff * d[i] * d[j]).abs()
+            } else if scale_max > 0.0 {
+                (diff / scale_max).abs()
+            } else {
+                diff.abs()
+            };
+            worst = worst.max(e);
+        }
+    }
+    fro.max(worst)
+}
+
+fn is_psd(m: &DMatrix<f64>) -> bool {
+    let norm = m.iter().fold(0.0f64, |a, v| a.max(v.abs()));
+    if norm == 0.0 {
+        return true;
+    }
+    let scaled = m / norm;
+    let fro = scaled.norm().max(1.0);
+    scaled.symmetric_eigen().eigenvalues.min() >= -1e-12 * fro
+}
+
+/// Runs one case.
+pub fn run_case(case: &Case) -> Outcome {
+    let (rd, peak) = dense_eval_peak::<TwoFloat>(case);
+    let r = DMatrix::from_row_slice(case.n, case.n, &rd.to_f64());
+    let (ours, ours_non_psd, ours_error) = match ours_eval(case) {
+        Ok(m) => (Some(rel_error(&m, &r, &peak)), !is_psd(&m), None),
+        Err(e @ CovError::NotPsd { .. }) => (None, true, Some(e.to_string())),
+        Err(e) => (None, false, Some(e.to_string())),
+    };
+    let (plain, plain_non_psd) = match (case.expect_error, plain_eval(case)) {
+        (true, _) | (_, None) => (None, false),
+        (false, Some(m)) => (Some(rel_error(&m, &r, &peak)), !is_psd(&m)),
+    };
+    Outcome {
+        name: case.name.clone(),
+        ops: case.ops.len(),
+        well_posed: case.well_posed,
+        expect_error: case.expect_error,
+        ours,
+        ours_non_psd,
+        ours_error,
+        plain,
+        plain_non_psd,
+    }
+}
+
+/// Runs every case.
+pub fn run(cases: &[Case]) -> Vec<Outcome> {
+    cases.iter().map(run_case).collect()
+}
+
+fn gauss(n: usize, stds: &[f64]) -> Vec<f64> {
+    let mut v = vec![0.0; n * n];
+    for i in 0..n {
+        v[i * n + i] = if stds[i].is_infinite() {
+            0.0
+        } else {
+            1.0 / (4.0 * PI * PI * stds[i] * stds[i])
+        };
+    }
+    v
+}
+
+fn correlated(n: usize, scale: f64) -> Vec<f64> {
+    // A well-conditioned correlated Σ times `scale`.
+    let mut v = vec![0.0; n * n];
+    for i in 0..n {
+        for j in 0..n {
+            v[i * n + j] = scale
+                * if i == j {
+                    2.0 + i as f64
+                } else {
+                    0.3 / (1.0 + (i + j) as f64)
+                };
+        }
+    }
+    v
+}
+
+/// The bundled stiff cases. `long` sets the length of the long chains (10⁴ in the suite).
+pub fn cases(long: usize) -> Vec<Case> {
+    let mut out = Vec::new();
+    let mut add = |name: &str, n: usize, start: Vec<f64>, ops: Vec<StiffOp>, well_posed: bool| {
+        let expect_error = !well_posed && name.contains("total internal reflection");
+        out.push(Case {
+            name: format!("{name} (N={n})"),
+            n,
+            start,
+            ops,
+            well_posed,
+            expect_error,
+        });
+    };
+    for n in [2, 4] {
+        let spot = gauss(
+            n,
+            &if n == 4 {
+                [0.01, 0.02, 0.1, 0.2]
+            } else {
+                [0.01, 0.1, 0.0, 0.0]
+            },
+        );
+        let spot = spot[..n * n].to_vec();
+        let dirac = {
+            let rel = 1e-6;
+            gauss(
+                n,
+                &if n == 4 {
+                    [rel, rel, f64::INFINITY, f64::INFINITY]
+                } else {
+                    [rel, f64::INFINITY, 0.0, 0.0]
+                },
+            )[..n * n]
+                .to_vec()
+        };
+        add(
+            "travel 1e-9 m",
+            n,
+            spot.clone(),
+            vec![StiffOp::Travel(1e-9)],
+            true,
+        );
+        add("travel 1e9 m", n, spot.clone(), vec![StiffOp::Travel(1e9)], true);
+        add("travel 1e6 m", n, spot.clone(), vec![StiffOp::Travel(1e6)], true);
+        add(
+            "Dirac source, travel 1e3 m",
+            n,
+            dirac.clone(),
+            vec![StiffOp::Travel(1e3)],
+            true,
+        );
+        add(
+            "diffuse bounce then travel 1e3 m",
+            n,
+            spot.clone(),
+            vec![StiffOp::Travel(1.0), StiffOp::Diffuse, StiffOp::Travel(1e3)],
+            true,
+        );
+        add(
+            "Dirac, travel 2 m, diffuse, travel 1e3 m",
+            n,
+            dirac.clone(),
+            vec![
+                StiffOp::Travel(2.0),
+                StiffOp::Project(0.5),
+                StiffOp::Diffuse,
+                StiffOp::Unproject(1.0),
+                StiffOp::Travel(1e3),
+            ],
+            true,
+        );
+        add(
+            "grazing cos 1e-12",
+            n,
+            spot.clone(),
+            vec![
+                StiffOp::Project(1e-12),
+                StiffOp::Phong(100.0),
+                StiffOp::Unproject(1e-12),
+            ],
+            true,
+        );
+        add(
+            "curvature 1e9 /m",
+            n,
+            spot.clone(),
+            vec![StiffOp::Curvature(1e9, 1e9, 0.0)],
+            true,
+        );
+        add(
+            "curvature 1e-9 /m",
+            n,
+            spot.clone(),
+            vec![StiffOp::Curvature(1e-9, 1e-9, 0.0)],
+            true,
+        );
+        if n == 4 {
+            add(
+                "anisotropic saddle ×50 with travel",
+                n,
+                correlated(n, 1.0),
+                (0..50)
+                    .flat_map(|i| {
+                        [
+                            StiffOp::Curvature(3.0, -2.0, 0.1 * i as f64),
+                            StiffOp::Travel(0.3),
+                        ]
+                    })
+                    .collect(),
+                true,
+            );
+        }
+        add(
+            "Phong 1",
+            n,
+            spot.clone(),
+            vec![StiffOp::Travel(0.5), StiffOp::Phong(1.0)],
+            true,
+        );
+        add(
+            "Phong 1e12",
+            n,
+            spot.clone(),
+            vec![StiffOp::Travel(0.5), StiffOp::Phong(1e12)],
+            true,
+        );
+        add(
+            "zero roughness (mirror)",
+            n,
+            spot.clone(),
+            vec![StiffOp::Travel(0.5), StiffOp::Phong(f64::INFINITY)],
+            true,
+        );
+        let cc = (1.0f64 - 1.0 / 2.25).sqrt();
+        add(
+            "refraction 1e-9 above the critical angle",
+            n,
+            spot.clone(),
+            vec![StiffOp::Refract(1.5, 1.0, cc * (1.0 + 1e-9))],
+            true,
+        );
+        add(
+            "total internal reflection",
+            n,
+            spot.clone(),
+            vec![StiffOp::Refract(1.5, 1.0, 0.5)],
+            false,
+        );
+        add(
+            "entries 1e-300",
+            n,
+            correlated(n, 1e-300),
+            vec![StiffOp::Travel(2.0), StiffOp::Phong(10.0)],
+            true,
+        );
+        add(
+            "entries 1e300",
+            n,
+            correlated(n, 1e300),
+            vec![StiffOp::Travel(2.0), StiffOp::Phong(10.0)],
+            true,
+        );
+        let mut rank1 = vec![0.0; n * n];
+        rank1[0] = 1.0;
+        add(
+            "rank-deficient Σ, lobe and diffuse",
+            n,
+            rank1,
+            vec![StiffOp::Travel(1.0), StiffOp::Phong(5.0), StiffOp::Diffuse],
+            true,
+        );
+        add(
+            &format!("{long} operators (bounces)"),
+            n,
+            spot.clone(),
+            (0..long / 4)
+                .flat_map(|i| {
+                    [
+                        StiffOp::Travel(0.5 + 0.01 * (i % 7) as f64),
+                        StiffOp::Curvature(1.0, 1.0, 0.0),
+                        StiffOp::Phong(200.0),
+                        StiffOp::Curvature(-1.0, -1.0, 0.0),
+                    ]
+                })
+                .collect(),
+            true,
+        );
+    }
+    out
+}
+
+/// The report as text lines.
+pub fn report(outcomes: &[Outcome]) -> String {
+    let mut s = format!(
+        "{:<50} {:>6} {:>12} {:>9} {:>12} {:>9}\n",
+        "case", "ops", "ours err", "ours PSD", "plain err", "plain PSD"
+    );
+    let fmt = |e: Option<f64>| e.map(|v| format!("{v:.2e}")).unwrap_or_else(|| "FAILED".into());
+    for o in outcomes {
+        s.push_str(&format!(
+            "{:<50} {:>6} {:>12} {:>9} {:>12} {:>9}\n",
+            o.name,
+            o.ops,
+            match (&o.ours_error, o.expect_error) {
+                (Some(_), true) => "typed err".to_string(),
+                (Some(_), false) => "error".to_string(),
+                (None, _) => fmt(o.ours),
+            },
+            if o.ours_non_psd { "NO" } else { "yes" },
+            if o.expect_error {
+                "n/a".to_string()
+            } else {
+                fmt(o.plain)
+            },
+            if o.expect_error {
+                "n/a"
+            } else if o.plain.is_none() {
+                "-"
+            } else if o.plain_non_psd {
+                "NO"
+            } else {
+                "yes"
+            },
+        ));
+    }
+    s
+}
