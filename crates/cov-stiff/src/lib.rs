@@ -91,6 +91,10 @@ pub struct Outcome {
     pub plain: Option<f64>,
     /// The plain result was not PSD.
     pub plain_non_psd: bool,
+    /// Conditioning: the reference's relative change per unit relative perturbation of
+    /// the start Σ (1e-12 applied). Times f64's ε, the error that storing the *input* in
+    /// f64 alone can cause; an error far above it comes from the evaluation.
+    pub amplification: f64,
 }
 
 fn phong_s(e: f64) -> f64 {
@@ -252,6 +256,9 @@ pub const RESOLUTION: f64 = 1e-12;
 /// axis' peak along the chain (`peak`), so that a small block is not hidden by a large one
 /// and an exactly cancelled one is judged at the precision f64 has there.
 pub fn rel_error(m: &DMatrix<f64>, r: &DMatrix<f64>, peak: &[f64]) -> f64 {
+    if m.iter().chain(r.iter()).any(|v| !v.is_finite()) {
+        return f64::INFINITY;
+    }
     let n = r.nrows();
     let scale_max = r.iter().fold(0.0f64, |a, v| a.max(v.abs()));
     let peak_max = peak.iter().fold(0.0f64, |a, v| a.max(*v));
@@ -303,6 +310,12 @@ pub fn run_case(case: &Case) -> Outcome {
         Err(e @ CovError::NotPsd { .. }) => (None, true, Some(e.to_string())),
         Err(e) => (None, false, Some(e.to_string())),
     };
+    let mut perturbed = case.clone();
+    for (k, v) in perturbed.start.iter_mut().enumerate() {
+        *v *= 1.0 + 1e-12 * if k % 3 == 0 { 1.0 } else { -0.7 };
+    }
+    let (rp, _) = dense_eval_peak::<TwoFloat>(&perturbed);
+    let amplification = rel_error(&DMatrix::from_row_slice(case.n, case.n, &rp.to_f64()), &r, &peak) / 1e-12;
     let (plain, plain_non_psd) = match (case.expect_error, plain_eval(case)) {
         (true, _) | (_, None) => (None, false),
         (false, Some(m)) => (Some(rel_error(&m, &r, &peak)), !is_psd(&m)),
@@ -317,6 +330,7 @@ pub fn run_case(case: &Case) -> Outcome {
         ours_error,
         plain,
         plain_non_psd,
+        amplification,
     }
 }
 
@@ -548,13 +562,13 @@ pub fn cases(long: usize) -> Vec<Case> {
 /// The report as text lines.
 pub fn report(outcomes: &[Outcome]) -> String {
     let mut s = format!(
-        "{:<50} {:>6} {:>12} {:>9} {:>12} {:>9}\n",
-        "case", "ops", "ours err", "ours PSD", "plain err", "plain PSD"
+        "{:<50} {:>6} {:>12} {:>9} {:>12} {:>9} {:>10}\n",
+        "case", "ops", "ours err", "ours PSD", "plain err", "plain PSD", "cond"
     );
     let fmt = |e: Option<f64>| e.map(|v| format!("{v:.2e}")).unwrap_or_else(|| "FAILED".into());
     for o in outcomes {
         s.push_str(&format!(
-            "{:<50} {:>6} {:>12} {:>9} {:>12} {:>9}\n",
+            "{:<50} {:>6} {:>12} {:>9} {:>12} {:>9} {:>10.1e}\n",
             o.name,
             o.ops,
             match (&o.ours_error, o.expect_error) {
@@ -577,6 +591,7 @@ pub fn report(outcomes: &[Outcome]) -> String {
             } else {
                 "yes"
             },
+            o.amplification,
         ));
     }
     s

@@ -139,7 +139,8 @@ impl<R: Real> Dense<R> {
         let col: Vec<R> = (0..n).map(|k| self.at(k, p)).collect();
         for i in 0..n {
             for j in 0..n {
-                let v = self.at(i, j) - (col[i] * col[j]).div_full(m);
+                // col_i · (col_j / m): no intermediate of size Σ², which overflows at 1e300.
+                let v = self.at(i, j) - col[i] * col[j].div_full(m);
                 self.set(i, j, v);
             }
         }
