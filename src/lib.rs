@@ -58,6 +58,8 @@ pub fn registry() -> cov_path::Registry {
     cov_defocus::spec::register(&mut r);
     #[cfg(feature = "sensor")]
     cov_sensor::spec::register(&mut r);
+    #[cfg(feature = "media")]
+    cov_media::spec::register(&mut r);
     r
 }
 
@@ -97,3 +99,8 @@ pub use cov_defocus as defocus;
 /// feature `sensor`).
 #[cfg(feature = "sensor")]
 pub use cov_sensor as sensor;
+
+/// Participating media: absorption, segments, scattering (crate `cov-media`, feature
+/// `media`).
+#[cfg(feature = "media")]
+pub use cov_media as media;
