@@ -1,6 +1,7 @@
 //! # cov-stiff: numerical stability on stiff and extreme cases
 //!
-//! A suite of chains at the extremes (grazing incidence to `cos = 1e-12`, distances and
+//! A suite of chains at the extremes (grazing incidence to `cos = 1e-12`, velocities from
+//! `1e-3` to `1e6` m/s, distances and
 //! curvatures from `1e-9` to `1e9`, Phong exponents from 1 to `1e12` and zero roughness,
 //! refraction a hair above the critical angle, a Dirac source, chains of `10⁴` operators,
 //! rank-deficient Σ, entries from `1e-300` to `1e300`), each evaluated three ways:
@@ -50,6 +51,9 @@ pub enum StiffOp {
     Diffuse,
     /// Smooth refraction `n1 → n2` at `cos_i`.
     Refract(f64, f64, f64),
+    /// A Gaussian window of std `std` (m) on `x` moving at `v` (m/s): enter the moving
+    /// frame (`x ← x + v·t`), window, leave (N = 3 only).
+    MovingWindow(f64, f64),
 }
 
 /// A stiff case.
@@ -57,7 +61,7 @@ pub enum StiffOp {
 pub struct Case {
     /// Name in the report.
     pub name: String,
-    /// Layout: 2 or 4.
+    /// Layout: 2, 3 or 4.
     pub n: usize,
     /// Σ at the start, row-major.
     pub start: Vec<f64>,
@@ -140,9 +144,23 @@ fn op_matrix(op: StiffOp, n: usize) -> Option<Vec<f64>> {
                 a[3 * n + 3] = n2 / n1;
             }
         }
-        StiffOp::Phong(_) | StiffOp::Diffuse => return None,
+        StiffOp::Phong(_) | StiffOp::Diffuse | StiffOp::MovingWindow(..) => return None,
     }
     Some(a)
+}
+
+/// The moving-frame shear `x ← x + v·t` of layout 3 (row-major).
+fn moving_frame(v: f64) -> Vec<f64> {
+    let mut a = vec![0.0; 9];
+    for i in 0..3 {
+        a[i * 3 + i] = 1.0;
+    }
+    a[2] = v;
+    a
+}
+
+fn window_var(std: f64) -> f64 {
+    1.0 / (4.0 * PI * PI * std * std)
 }
 
 fn lobe_axes(n: usize) -> &'static [usize] {
@@ -168,7 +186,11 @@ pub fn dense_eval_peak<R: Real>(case: &Case) -> (Dense<R>, Vec<f64>) {
     let mut d = Dense::<R>::from_f64(case.n, &case.start);
     let mut peak: Vec<f64> = (0..case.n).map(|i| d.at(i, i).to()).collect();
     for &op in &case.ops {
-        if let Some(a) = op_matrix(op, case.n) {
+        if let StiffOp::MovingWindow(v, std) = op {
+            d.congruence(&moving_frame(v));
+            d.window(0, window_var(std));
+            d.congruence(&moving_frame(-v));
+        } else if let Some(a) = op_matrix(op, case.n) {
             d.congruence(&a);
         } else if let Some(s) = lobe_s(op) {
             for &p in lobe_axes(case.n) {
@@ -188,7 +210,13 @@ pub fn plain_eval(case: &Case) -> Option<DMatrix<f64>> {
     let n = case.n;
     let mut s = DMatrix::from_row_slice(n, n, &case.start);
     for &op in &case.ops {
-        if let Some(a) = op_matrix(op, n) {
+        if let StiffOp::MovingWindow(v, std) = op {
+            let enter = DMatrix::from_row_slice(3, 3, &moving_frame(v));
+            let leave = DMatrix::from_row_slice(3, 3, &moving_frame(-v));
+            s = enter.transpose() * &s * enter;
+            s[(0, 0)] += window_var(std);
+            s = leave.transpose() * &s * leave;
+        } else if let Some(a) = op_matrix(op, n) {
             let a = DMatrix::from_row_slice(n, n, &a);
             s = a.transpose() * &s * a;
         } else if let Some(sl) = lobe_s(op) {
@@ -216,6 +244,7 @@ pub fn plain_eval(case: &Case) -> Option<DMatrix<f64>> {
 pub fn ours_eval(case: &Case) -> Result<DMatrix<f64>, CovError> {
     match case.n {
         2 => ours_n::<2>(case),
+        3 => ours_n::<3>(case),
         _ => ours_n::<4>(case),
     }
 }
@@ -234,6 +263,14 @@ fn ours_n<const N: usize>(case: &Case) -> Result<DMatrix<f64>, CovError> {
             StiffOp::Phong(e) => chain.push(Brdf::new(Lobe::phong(e)?)?),
             StiffOp::Diffuse => chain.push(Brdf::new(Lobe::Diffuse)?),
             StiffOp::Refract(n1, n2, c) => chain.push(Refract::new(n1, n2, c)?),
+            StiffOp::MovingWindow(v, std) => {
+                let window = cov_motion::test_window(std)?;
+                chain.push(cov_motion::Moving::new(
+                    [v, 0.0],
+                    [0.0, 0.0],
+                    vec![cov_path::DynOperator(std::sync::Arc::new(window))],
+                )?);
+            }
         }
     }
     let c = chain.eval(start)?;
@@ -553,6 +590,21 @@ pub fn cases(long: usize) -> Vec<Case> {
                     ]
                 })
                 .collect(),
+            true,
+        );
+    }
+    // Motion (N = 3: x, u, t): velocities from 1e-3 to 1e6 m/s.
+    let start3 = gauss(3, &[0.1, 0.2, 0.01]);
+    for v in [1e-3, 1.0, 1e3, 1e6] {
+        add(
+            &format!("occluder moving at {v:e} m/s, then travel"),
+            3,
+            start3.clone(),
+            vec![
+                StiffOp::MovingWindow(v, 0.01),
+                StiffOp::Travel(1.0),
+                StiffOp::Phong(100.0),
+            ],
             true,
         );
     }
