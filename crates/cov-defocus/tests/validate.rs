@@ -61,21 +61,7 @@ fn integrated_image_matches_ground_truth_after_aperture_and_shutter() {
         acc * hu * ht
     });
     let sigma = predicted.get(0, 0);
-    let sw = 1.0 / (2.0 * std::f64::consts::PI * (0.25 * sigma).sqrt());
-    let h = {
-        let tot = (sigma + 1.0 / (4.0 * std::f64::consts::PI.powi(2) * sw * sw)).sqrt();
-        let c = (128.0 / (4.0 * sw * tot)).sqrt();
-        1.0 / (2.0 * c * tot)
-    };
-    let m = measure(
-        &image,
-        &cov_validate::Grid {
-            size: 128,
-            spacing: vec![h],
-            window_std: vec![sw],
-        },
-    )
-    .unwrap();
+    let m = measure(&image, &Grid::from_diagonal(&[sigma], 128, &[1.0])).unwrap();
     let err = (m[(0, 0)] - sigma).abs() / sigma;
     assert!(
         err < 1e-3,

@@ -35,7 +35,7 @@
 //! use cov_path::DynOperator;
 //! use std::sync::Arc;
 //!
-//! let window = cov_motion::test_window(0.001)?; // a 1 mm Gaussian window
+//! let window = cov_occlusion::Window::isotropic(0.001)?; // a 1 mm Gaussian occluder
 //! let moving = Moving::new([2.0, 0.0], [0.0, 0.0], vec![DynOperator(Arc::new(window))])?;
 //! let mut c = Cov::<3>::zeros();
 //! Operator::<3>::apply(&moving, &mut c)?;
@@ -251,32 +251,5 @@ impl<const N: usize> Operator<N> for Shutter {
     }
     fn requires(&self) -> AxisSet {
         AxisSet::FLAT_TIME
-    }
-}
-
-/// A Gaussian window of std `std` on the spatial axes: for examples and tests of
-/// [`Moving`] without depending on cov-occlusion.
-///
-/// # Errors
-/// Non-positive or non-finite `std`.
-pub fn test_window(
-    std: f64,
-) -> Result<impl Operator<2> + Operator<3> + Operator<4> + Operator<5> + Clone, CovError> {
-    CovError::check_positive("test_window", "std", std)?;
-    Ok(SpatialWindow(1.0 / (FOUR_PI_SQ * std * std)))
-}
-
-#[derive(Clone, Copy, Debug)]
-struct SpatialWindow(f64);
-
-impl<const N: usize> Operator<N> for SpatialWindow {
-    fn apply(&self, cov: &mut Cov<N>) -> Result<(), CovError> {
-        for &a in Cov::<N>::spatial_axes() {
-            cov.add_variance(a, self.0)?;
-        }
-        Ok(())
-    }
-    fn name(&self) -> &str {
-        "Window"
     }
 }

@@ -3,7 +3,8 @@
 use std::sync::Arc;
 
 use cov_core::{Axis, Cov, Operator};
-use cov_motion::{CameraMotion, Moving, Shutter, ShutterShape, test_window};
+use cov_motion::{CameraMotion, Moving, Shutter, ShutterShape};
+use cov_occlusion::Window;
 use cov_path::DynOperator;
 use cov_validate::{Field, Grid, Primal, compare};
 
@@ -13,7 +14,7 @@ fn moving_window(v: f64, s: f64) -> Moving {
     Moving::new(
         [v, 0.0],
         [0.0, 0.0],
-        vec![DynOperator(Arc::new(test_window(s).unwrap()))],
+        vec![DynOperator(Arc::new(Window::isotropic(s).unwrap()))],
     )
     .unwrap()
 }

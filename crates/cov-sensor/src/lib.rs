@@ -229,13 +229,11 @@ impl Sensor {
         self.pixel_filter(&mut c)?;
         let image_axes = Cov::<N>::spatial_axes();
         let n_img = image_axes.len();
-        // Image-space Σ: integrate over everything but position; to pixels.
-        let img = c.integrated(image_axes)?;
-        let p2 = self.pitch * self.pitch;
-        let image_cov_px: Vec<Vec<f64>> = (0..n_img)
-            .map(|i| (0..n_img).map(|j| img.get(i, j) * p2).collect())
-            .collect();
+        // Image-space Σ: integrate over everything but position, in pixel units.
         let img_px = scaled_block(&c, image_axes, self.pitch)?;
+        let image_cov_px: Vec<Vec<f64>> = (0..n_img)
+            .map(|i| (0..n_img).map(|j| img_px.get(i, j)).collect())
+            .collect();
         let filter = img_px.reconstruction_filter(&vec![self.p.max_filter; n_img])?;
         // Sampled domain: image, lens (with an aperture), time (with a shutter).
         let mut keep: Vec<Axis> = image_axes.to_vec();

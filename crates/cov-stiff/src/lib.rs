@@ -264,7 +264,7 @@ fn ours_n<const N: usize>(case: &Case) -> Result<DMatrix<f64>, CovError> {
             StiffOp::Diffuse => chain.push(Brdf::new(Lobe::Diffuse)?),
             StiffOp::Refract(n1, n2, c) => chain.push(Refract::new(n1, n2, c)?),
             StiffOp::MovingWindow(v, std) => {
-                let window = cov_motion::test_window(std)?;
+                let window = cov_occlusion::Window::isotropic(std)?;
                 chain.push(cov_motion::Moving::new(
                     [v, 0.0],
                     [0.0, 0.0],

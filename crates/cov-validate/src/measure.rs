@@ -52,10 +52,18 @@ impl Grid {
     /// (`±c` window stds) and the spectral coverage (`±c` total spectrum stds, below
     /// Nyquist), giving `c = √(size / (4 s_w σ_tot))`: about 6.7 std for 64 samples.
     pub fn auto<const N: usize>(predicted: &Cov<N>, size: usize, fallback_std: &[f64]) -> Grid {
-        let mut spacing = Vec::with_capacity(N);
-        let mut window_std = Vec::with_capacity(N);
-        for i in 0..N {
-            let p = predicted.get(i, i).max(0.0);
+        let diagonal: Vec<f64> = (0..N).map(|i| predicted.get(i, i)).collect();
+        Self::from_diagonal(&diagonal, size, fallback_std)
+    }
+
+    /// [`Grid::auto`] from the predicted spectrum variance per axis, for fields of any
+    /// dimension (e.g. a 1-D image integrated by quadrature).
+    pub fn from_diagonal(diagonal: &[f64], size: usize, fallback_std: &[f64]) -> Grid {
+        let n = diagonal.len();
+        let mut spacing = Vec::with_capacity(n);
+        let mut window_std = Vec::with_capacity(n);
+        for (i, d) in diagonal.iter().enumerate() {
+            let p = d.max(0.0);
             let sw = if p > 0.0 {
                 1.0 / (2.0 * std::f64::consts::PI * (WINDOW_FRACTION * p).sqrt())
             } else {
