@@ -70,7 +70,7 @@
 
 pub mod spec;
 
-use cov_core::{Cov, CovError, FOUR_PI_SQ, Operator};
+use cov_core::{Cov, CovError, FOUR_PI_SQ, Operator, Spectrum};
 use cov_curvature::Curvature;
 use cov_projection::{Mirror, Project, Unproject};
 
@@ -191,7 +191,7 @@ impl Lobe {
     ///
     /// # Errors
     /// Overflow.
-    pub fn apply_to<const N: usize>(&self, cov: &mut Cov<N>) -> Result<(), CovError> {
+    pub fn apply_to<const N: usize>(&self, cov: &mut dyn Spectrum<N>) -> Result<(), CovError> {
         let (vu, vv) = self.variances();
         let dirs = Cov::<N>::direction_axes();
         for (&axis, var) in dirs.iter().zip([vu, vv]) {
@@ -232,7 +232,7 @@ impl Brdf {
 }
 
 impl<const N: usize> Operator<N> for Brdf {
-    fn apply(&self, cov: &mut Cov<N>) -> Result<(), CovError> {
+    fn apply(&self, cov: &mut dyn Spectrum<N>) -> Result<(), CovError> {
         self.lobe.apply_to(cov)
     }
     fn name(&self) -> &str {
@@ -267,7 +267,7 @@ impl Reflect {
 }
 
 impl<const N: usize> Operator<N> for Reflect {
-    fn apply(&self, cov: &mut Cov<N>) -> Result<(), CovError> {
+    fn apply(&self, cov: &mut dyn Spectrum<N>) -> Result<(), CovError> {
         Operator::<N>::apply(&self.project, cov)?;
         // Incident directions in the surface frame point back toward the light.
         Operator::<N>::apply(&Mirror, cov)?;

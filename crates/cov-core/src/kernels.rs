@@ -213,7 +213,7 @@ impl<const N: usize> Cov<N> {
     /// # Errors
     /// Missing or repeated axis, wrong size, `W` not finite, symmetric and PSD; overflow.
     pub fn add_window(&mut self, axes: &[Axis], w: &[f64]) -> Result<(), CovError> {
-        let (idx, k) = self.resolve("add_window", axes)?;
+        let (idx, k) = resolve::<N>("add_window", axes)?;
         let wm = block_from_slice("add_window", "W", k, w)?;
         let old = *self;
         for a in 0..k {
@@ -246,7 +246,7 @@ impl<const N: usize> Cov<N> {
             self.lobe_product_1(p, *s1);
             return self.finish("convolve", old);
         }
-        let (idx, k) = self.resolve("convolve", axes)?;
+        let (idx, k) = resolve::<N>("convolve", axes)?;
         let sm = block_from_slice("convolve", "S", k, s)?;
         let old = *self;
         self.lobe_product(&idx[..k], &sm);
@@ -270,7 +270,7 @@ impl<const N: usize> Cov<N> {
             self.lobe_product_1(p, 0.0);
             return Ok(());
         }
-        let (idx, k) = self.resolve("integrate", axes)?;
+        let (idx, k) = resolve::<N>("integrate", axes)?;
         let old = *self;
         self.lobe_product(&idx[..k], &[[0.0; MAX]; MAX]);
         self.finish("integrate", old)
@@ -394,28 +394,6 @@ impl<const N: usize> Cov<N> {
         }
     }
 
-    fn resolve(&self, op: &str, axes: &[Axis]) -> Result<([usize; MAX], usize), CovError> {
-        let mut idx = [0usize; MAX];
-        if axes.is_empty() || axes.len() > N {
-            return Err(CovError::Shape {
-                what: op.into(),
-                expected: format!("1 to {N} axes"),
-                got: format!("{} axes", axes.len()),
-            });
-        }
-        for (a, axis) in axes.iter().enumerate() {
-            idx[a] = Self::index(*axis)?;
-            if idx[..a].contains(&idx[a]) {
-                return Err(CovError::Shape {
-                    what: op.into(),
-                    expected: "distinct axes".into(),
-                    got: format!("`{axis}` twice"),
-                });
-            }
-        }
-        Ok((idx, axes.len()))
-    }
-
     /// Checks the result of a kernel; on overflow restores the input and reports.
     #[inline]
     fn finish(&mut self, op: &str, old: Self) -> Result<(), CovError> {
@@ -469,4 +447,27 @@ pub(crate) fn block_from_slice(op: &str, name: &str, k: usize, w: &[f64]) -> Res
         });
     }
     Ok(m)
+}
+
+/// The indices of `axes` in layout `N` (at most `N`, distinct), for kernel `op`.
+pub(crate) fn resolve<const N: usize>(op: &str, axes: &[Axis]) -> Result<([usize; MAX], usize), CovError> {
+    let mut idx = [0usize; MAX];
+    if axes.is_empty() || axes.len() > N {
+        return Err(CovError::Shape {
+            what: op.into(),
+            expected: format!("1 to {N} axes"),
+            got: format!("{} axes", axes.len()),
+        });
+    }
+    for (a, axis) in axes.iter().enumerate() {
+        idx[a] = Cov::<N>::index(*axis)?;
+        if idx[..a].contains(&idx[a]) {
+            return Err(CovError::Shape {
+                what: op.into(),
+                expected: "distinct axes".into(),
+                got: format!("`{axis}` twice"),
+            });
+        }
+    }
+    Ok((idx, axes.len()))
 }

@@ -55,14 +55,18 @@
 mod axis;
 mod cov;
 mod error;
+mod factor;
 pub mod kernels;
 pub mod linalg;
 mod operator;
 mod query;
+mod spectrum;
 
 pub use axis::{Axis, AxisSet, axis_index, layout_axes, layout_set};
 pub use cov::{Cov, DIRAC_RELATIVE_SIZE, FOUR_PI_SQ, PSD_RTOL, Validity};
 pub use error::CovError;
+pub use factor::CovFactor;
 pub use kernels::SCHUR_SNAP;
 pub use operator::{Chain, Operator, Step, Trace, check_layout};
 pub use query::{CovBlock, Filter, NYQUIST_K, primal_std_of_spectrum};
+pub use spectrum::{Form, Snapshot, Spectrum, SpectrumMut};

@@ -1,6 +1,6 @@
 //! Degenerate input gives a documented result, never NaN or a panic.
 
-use cov_core::{Axis, Chain, Cov, CovError, Operator};
+use cov_core::{Axis, Chain, Cov, CovError, Operator, Spectrum};
 use nalgebra::SMatrix;
 
 fn all_kernels<const N: usize>(c: Cov<N>) -> Vec<Result<Cov<N>, CovError>> {
@@ -133,16 +133,18 @@ fn non_finite_parameters_are_rejected() {
 #[derive(Debug)]
 struct Boom;
 impl<const N: usize> Operator<N> for Boom {
-    fn apply(&self, c: &mut Cov<N>) -> Result<(), CovError> {
-        c.set(0, 0, f64::NAN);
-        Ok(())
+    fn apply(&self, c: &mut dyn Spectrum<N>) -> Result<(), CovError> {
+        // Writes Σ directly, as an operator outside the kernels would.
+        let mut x = c.cov()?;
+        x.set(0, 0, f64::NAN);
+        c.assign(&x)
     }
 }
 
 #[derive(Debug)]
 struct Travel(f64);
 impl<const N: usize> Operator<N> for Travel {
-    fn apply(&self, c: &mut Cov<N>) -> Result<(), CovError> {
+    fn apply(&self, c: &mut dyn Spectrum<N>) -> Result<(), CovError> {
         c.shear(Axis::X, Axis::U, -self.0)
     }
 }

@@ -51,7 +51,7 @@
 
 pub mod spec;
 
-use cov_core::{Axis, AxisSet, Cov, CovError, Operator};
+use cov_core::{Axis, AxisSet, Cov, CovError, Operator, Spectrum};
 
 /// Curvature by principal curvatures and direction.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -119,7 +119,7 @@ impl Curvature {
     /// `cos` not in (0, 1], `sign` not finite, overflow.
     pub fn apply_oblique<const N: usize>(
         &self,
-        cov: &mut Cov<N>,
+        cov: &mut dyn Spectrum<N>,
         cos: f64,
         sign: f64,
     ) -> Result<(), CovError> {
@@ -154,7 +154,7 @@ impl Curvature {
 }
 
 impl<const N: usize> Operator<N> for Curvature {
-    fn apply(&self, cov: &mut Cov<N>) -> Result<(), CovError> {
+    fn apply(&self, cov: &mut dyn Spectrum<N>) -> Result<(), CovError> {
         if self.is_isotropic() {
             for &(p, d) in Cov::<N>::transverse_pairs() {
                 cov.shear(d, p, self.kx)?;
@@ -204,7 +204,7 @@ impl CurvatureTensor {
 }
 
 impl<const N: usize> Operator<N> for CurvatureTensor {
-    fn apply(&self, cov: &mut Cov<N>) -> Result<(), CovError> {
+    fn apply(&self, cov: &mut dyn Spectrum<N>) -> Result<(), CovError> {
         let [kxx, kxy, kyy] = self.k;
         cov.shear(Axis::U, Axis::X, kxx)?;
         if Cov::<N>::has(Axis::Y) {

@@ -51,7 +51,7 @@
 
 pub mod spec;
 
-use cov_core::{Cov, CovError, FOUR_PI_SQ, Operator};
+use cov_core::{Cov, CovError, FOUR_PI_SQ, Operator, Spectrum};
 
 /// A thin lens with a Gaussian aperture, focused at `focus_distance`; ends at the sensor.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -99,7 +99,7 @@ impl ThinLens {
 }
 
 impl<const N: usize> Operator<N> for ThinLens {
-    fn apply(&self, cov: &mut Cov<N>) -> Result<(), CovError> {
+    fn apply(&self, cov: &mut dyn Spectrum<N>) -> Result<(), CovError> {
         let w = 1.0 / (FOUR_PI_SQ * self.aperture * self.aperture);
         for &(x, u) in Cov::<N>::transverse_pairs() {
             cov.add_variance(x, w)?;
@@ -133,7 +133,7 @@ impl Pinhole {
 }
 
 impl<const N: usize> Operator<N> for Pinhole {
-    fn apply(&self, cov: &mut Cov<N>) -> Result<(), CovError> {
+    fn apply(&self, cov: &mut dyn Spectrum<N>) -> Result<(), CovError> {
         // (x, u) ↦ (0, x/d_s) on each pair; time untouched.
         let mut a = nalgebra::SMatrix::<f64, N, N>::identity();
         for &(x, u) in Cov::<N>::transverse_pairs() {

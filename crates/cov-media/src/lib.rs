@@ -83,7 +83,7 @@ pub mod spec;
 
 use std::f64::consts::{FRAC_PI_2, PI};
 
-use cov_core::{Axis, AxisSet, Cov, CovError, FOUR_PI_SQ, Operator};
+use cov_core::{Axis, AxisSet, Cov, CovError, FOUR_PI_SQ, Operator, Spectrum};
 
 /// Absorption over a segment of a heterogeneous medium, as a window at its start.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -141,7 +141,7 @@ fn psd_part([a, b, c]: [f64; 3]) -> [f64; 3] {
 }
 
 impl<const N: usize> Operator<N> for Absorption {
-    fn apply(&self, cov: &mut Cov<N>) -> Result<(), CovError> {
+    fn apply(&self, cov: &mut dyn Spectrum<N>) -> Result<(), CovError> {
         let l = self.length;
         let (q0, q1, q2) = (l, 0.5 * l * l, l * l * l / 3.0);
         let [hxx, hxy, hyy] = self.h;
@@ -194,7 +194,7 @@ impl Segment {
 }
 
 impl<const N: usize> Operator<N> for Segment {
-    fn apply(&self, cov: &mut Cov<N>) -> Result<(), CovError> {
+    fn apply(&self, cov: &mut dyn Spectrum<N>) -> Result<(), CovError> {
         Operator::<N>::apply(&self.absorption, cov)?;
         for &(p, d) in Cov::<N>::transverse_pairs() {
             cov.shear(p, d, -self.absorption.length)?;
@@ -399,7 +399,7 @@ impl Scatter {
 }
 
 impl<const N: usize> Operator<N> for Scatter {
-    fn apply(&self, cov: &mut Cov<N>) -> Result<(), CovError> {
+    fn apply(&self, cov: &mut dyn Spectrum<N>) -> Result<(), CovError> {
         if self.azimuth != 0.0 {
             cov.rotate_frame(self.azimuth)?;
         }

@@ -69,7 +69,7 @@
 
 pub mod spec;
 
-use cov_core::{Axis, AxisSet, Cov, CovError, FOUR_PI_SQ, Operator};
+use cov_core::{Axis, AxisSet, Cov, CovError, FOUR_PI_SQ, Operator, Spectrum};
 use cov_path::{DynOperator, Operators};
 
 /// The frame of an object in motion: linear and angular velocity in the tangent plane.
@@ -111,7 +111,7 @@ impl MotionFrame {
     ///
     /// # Errors
     /// Missing time axis, overflow.
-    pub fn shear<const N: usize>(&self, cov: &mut Cov<N>, sign: f64) -> Result<(), CovError> {
+    pub fn shear<const N: usize>(&self, cov: &mut dyn Spectrum<N>, sign: f64) -> Result<(), CovError> {
         let pairs = [
             (Axis::X, self.v[0]),
             (Axis::Y, self.v[1]),
@@ -150,7 +150,7 @@ impl Moving {
 }
 
 impl<const N: usize> Operator<N> for Moving {
-    fn apply(&self, cov: &mut Cov<N>) -> Result<(), CovError> {
+    fn apply(&self, cov: &mut dyn Spectrum<N>) -> Result<(), CovError> {
         self.frame.shear(cov, 1.0)?;
         self.operators.apply(cov)?;
         self.frame.shear(cov, -1.0)
@@ -183,7 +183,7 @@ impl CameraMotion {
 }
 
 impl<const N: usize> Operator<N> for CameraMotion {
-    fn apply(&self, cov: &mut Cov<N>) -> Result<(), CovError> {
+    fn apply(&self, cov: &mut dyn Spectrum<N>) -> Result<(), CovError> {
         self.frame.shear(cov, 1.0)
     }
     fn name(&self) -> &str {
@@ -243,7 +243,7 @@ impl Shutter {
 }
 
 impl<const N: usize> Operator<N> for Shutter {
-    fn apply(&self, cov: &mut Cov<N>) -> Result<(), CovError> {
+    fn apply(&self, cov: &mut dyn Spectrum<N>) -> Result<(), CovError> {
         cov.add_variance(Axis::T, self.w)
     }
     fn name(&self) -> &str {

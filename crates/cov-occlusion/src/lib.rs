@@ -54,7 +54,7 @@
 
 pub mod spec;
 
-use cov_core::{Axis, Cov, CovError, FOUR_PI_SQ, Operator};
+use cov_core::{Axis, Cov, CovError, FOUR_PI_SQ, Operator, Spectrum};
 
 fn window_var(op: &str, name: &str, std: f64) -> Result<f64, CovError> {
     CovError::check_positive(op, name, std)?;
@@ -95,7 +95,7 @@ impl Window {
 }
 
 impl<const N: usize> Operator<N> for Window {
-    fn apply(&self, cov: &mut Cov<N>) -> Result<(), CovError> {
+    fn apply(&self, cov: &mut dyn Spectrum<N>) -> Result<(), CovError> {
         cov.add_variance(Axis::X, self.wx)?;
         if Cov::<N>::has(Axis::Y) {
             cov.add_variance(Axis::Y, self.wy)?;
@@ -136,7 +136,7 @@ impl BlockerEdge {
 }
 
 impl<const N: usize> Operator<N> for BlockerEdge {
-    fn apply(&self, cov: &mut Cov<N>) -> Result<(), CovError> {
+    fn apply(&self, cov: &mut dyn Spectrum<N>) -> Result<(), CovError> {
         Operator::<N>::apply(&self.window, cov)
     }
     fn name(&self) -> &str {
@@ -185,7 +185,7 @@ impl Texture {
 }
 
 impl<const N: usize> Operator<N> for Texture {
-    fn apply(&self, cov: &mut Cov<N>) -> Result<(), CovError> {
+    fn apply(&self, cov: &mut dyn Spectrum<N>) -> Result<(), CovError> {
         if Cov::<N>::has(Axis::Y) {
             cov.add_window(&[Axis::X, Axis::Y], &[self.s[0], self.s[1], self.s[1], self.s[2]])
         } else {
@@ -232,7 +232,7 @@ impl ThickOccluder {
 }
 
 impl<const N: usize> Operator<N> for ThickOccluder {
-    fn apply(&self, cov: &mut Cov<N>) -> Result<(), CovError> {
+    fn apply(&self, cov: &mut dyn Spectrum<N>) -> Result<(), CovError> {
         for _ in 0..self.slices {
             Operator::<N>::apply(&self.window, cov)?;
             for &(p, d) in Cov::<N>::transverse_pairs() {

@@ -2,7 +2,7 @@
 
 use std::cell::RefCell;
 
-use cov_core::{AxisSet, Cov, CovError, Operator};
+use cov_core::{AxisSet, CovError, Operator, Spectrum};
 use serde::de::{Deserialize, DeserializeSeed, Deserializer, Error};
 
 use crate::path::OpsSeed;
@@ -41,7 +41,7 @@ impl Operators {
     ///
     /// # Errors
     /// The first failing operator's error.
-    pub fn apply<const N: usize>(&self, cov: &mut Cov<N>) -> Result<(), CovError> {
+    pub fn apply<const N: usize>(&self, cov: &mut dyn Spectrum<N>) -> Result<(), CovError> {
         for op in &self.0 {
             Operator::<N>::apply(op, cov)?;
         }

@@ -4,7 +4,7 @@ use std::collections::BTreeMap;
 use std::fmt;
 use std::sync::Arc;
 
-use cov_core::{AxisSet, Cov, CovError, Operator};
+use cov_core::{AxisSet, CovError, Operator, Spectrum, SpectrumMut};
 use serde::de::DeserializeOwned;
 
 /// An operator whose layout is chosen at run time: what a path holds. Implemented for
@@ -18,22 +18,22 @@ pub trait PathOperator: fmt::Debug + Send + Sync {
     ///
     /// # Errors
     /// As the operator.
-    fn apply2(&self, c: &mut Cov<2>) -> Result<(), CovError>;
+    fn apply2(&self, c: &mut dyn Spectrum<2>) -> Result<(), CovError>;
     /// Applies in flatland with time.
     ///
     /// # Errors
     /// As the operator.
-    fn apply3(&self, c: &mut Cov<3>) -> Result<(), CovError>;
+    fn apply3(&self, c: &mut dyn Spectrum<3>) -> Result<(), CovError>;
     /// Applies in 3D.
     ///
     /// # Errors
     /// As the operator.
-    fn apply4(&self, c: &mut Cov<4>) -> Result<(), CovError>;
+    fn apply4(&self, c: &mut dyn Spectrum<4>) -> Result<(), CovError>;
     /// Applies in 3D with time.
     ///
     /// # Errors
     /// As the operator.
-    fn apply5(&self, c: &mut Cov<5>) -> Result<(), CovError>;
+    fn apply5(&self, c: &mut dyn Spectrum<5>) -> Result<(), CovError>;
     /// The concrete operator, for callers that look for a particular one (the CLI finds a
     /// final `Sensor` this way).
     fn as_any(&self) -> &dyn std::any::Any;
@@ -52,16 +52,16 @@ where
     fn op_requires(&self) -> AxisSet {
         Operator::<5>::requires(self)
     }
-    fn apply2(&self, c: &mut Cov<2>) -> Result<(), CovError> {
+    fn apply2(&self, c: &mut dyn Spectrum<2>) -> Result<(), CovError> {
         Operator::<2>::apply(self, c)
     }
-    fn apply3(&self, c: &mut Cov<3>) -> Result<(), CovError> {
+    fn apply3(&self, c: &mut dyn Spectrum<3>) -> Result<(), CovError> {
         Operator::<3>::apply(self, c)
     }
-    fn apply4(&self, c: &mut Cov<4>) -> Result<(), CovError> {
+    fn apply4(&self, c: &mut dyn Spectrum<4>) -> Result<(), CovError> {
         Operator::<4>::apply(self, c)
     }
-    fn apply5(&self, c: &mut Cov<5>) -> Result<(), CovError> {
+    fn apply5(&self, c: &mut dyn Spectrum<5>) -> Result<(), CovError> {
         Operator::<5>::apply(self, c)
     }
 }
@@ -71,25 +71,13 @@ where
 pub struct DynOperator(pub Arc<dyn PathOperator>);
 
 impl<const N: usize> Operator<N> for DynOperator {
-    fn apply(&self, cov: &mut Cov<N>) -> Result<(), CovError> {
-        // Invariant: `Cov<N>` only exists for N = 2..=5, and `cast` succeeds exactly when the
-        // sizes agree, so one arm below always runs.
-        macro_rules! arm {
-            ($m:literal, $f:ident) => {
-                if let Some(mut c) = cov.cast::<$m>() {
-                    self.0.$f(&mut c)?;
-                    if let Some(back) = c.cast::<N>() {
-                        *cov = back;
-                    }
-                    return Ok(());
-                }
-            };
+    fn apply(&self, cov: &mut dyn Spectrum<N>) -> Result<(), CovError> {
+        match cov.layout() {
+            SpectrumMut::Two(c) => self.0.apply2(c),
+            SpectrumMut::Three(c) => self.0.apply3(c),
+            SpectrumMut::Four(c) => self.0.apply4(c),
+            SpectrumMut::Five(c) => self.0.apply5(c),
         }
-        arm!(2, apply2);
-        arm!(3, apply3);
-        arm!(4, apply4);
-        arm!(5, apply5);
-        Ok(())
     }
     fn name(&self) -> &str {
         self.0.op_name()
@@ -183,13 +171,13 @@ fn build_unit<S: OperatorSpec>() -> Option<Result<Arc<dyn PathOperator>, CovErro
 /// a third party adds its own with one call:
 ///
 /// ```
-/// use cov_core::{Axis, Cov, CovError, Operator};
+/// use cov_core::{Axis, Cov, CovError, Operator, Spectrum};
 /// use cov_path::{OperatorSpec, Param, Path, Registry};
 ///
 /// #[derive(Debug)]
 /// struct Blur(f64);
 /// impl<const N: usize> Operator<N> for Blur {
-///     fn apply(&self, c: &mut Cov<N>) -> Result<(), CovError> { c.convolve(&[Axis::U], &[self.0]) }
+///     fn apply(&self, c: &mut dyn Spectrum<N>) -> Result<(), CovError> { c.convolve(&[Axis::U], &[self.0]) }
 ///     fn name(&self) -> &str { "Blur" }
 /// }
 ///

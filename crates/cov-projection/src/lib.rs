@@ -59,14 +59,14 @@
 
 pub mod spec;
 
-use cov_core::{Axis, AxisSet, Cov, CovError, Operator};
+use cov_core::{Axis, AxisSet, Cov, CovError, Operator, Spectrum};
 use glam::DVec3;
 
 fn check_cos(op: &str, c: f64) -> Result<f64, CovError> {
     CovError::check_range(op, "cos", c, |c| c > 0.0 && c <= 1.0, "must be in (0, 1]")
 }
 
-fn rotate<const N: usize>(cov: &mut Cov<N>, angle: f64) -> Result<(), CovError> {
+fn rotate<const N: usize>(cov: &mut dyn Spectrum<N>, angle: f64) -> Result<(), CovError> {
     if angle != 0.0 {
         cov.rotate_frame(angle)
     } else {
@@ -162,7 +162,7 @@ impl Project {
 }
 
 impl<const N: usize> Operator<N> for Project {
-    fn apply(&self, cov: &mut Cov<N>) -> Result<(), CovError> {
+    fn apply(&self, cov: &mut dyn Spectrum<N>) -> Result<(), CovError> {
         rotate(cov, self.angle)?;
         cov.scale(Axis::X, self.cos)
     }
@@ -209,7 +209,7 @@ impl Unproject {
 }
 
 impl<const N: usize> Operator<N> for Unproject {
-    fn apply(&self, cov: &mut Cov<N>) -> Result<(), CovError> {
+    fn apply(&self, cov: &mut dyn Spectrum<N>) -> Result<(), CovError> {
         cov.scale(Axis::X, 1.0 / self.cos)?;
         rotate(cov, self.angle)
     }
@@ -231,7 +231,7 @@ impl Mirror {
 }
 
 impl<const N: usize> Operator<N> for Mirror {
-    fn apply(&self, cov: &mut Cov<N>) -> Result<(), CovError> {
+    fn apply(&self, cov: &mut dyn Spectrum<N>) -> Result<(), CovError> {
         for &a in Cov::<N>::direction_axes() {
             cov.scale(a, -1.0)?;
         }
@@ -262,7 +262,7 @@ impl RotateFrame {
 }
 
 impl<const N: usize> Operator<N> for RotateFrame {
-    fn apply(&self, cov: &mut Cov<N>) -> Result<(), CovError> {
+    fn apply(&self, cov: &mut dyn Spectrum<N>) -> Result<(), CovError> {
         cov.rotate_frame(self.angle)
     }
     fn name(&self) -> &str {

@@ -58,7 +58,7 @@
 pub mod spec;
 
 use cov_brdf::Lobe;
-use cov_core::{Axis, Cov, CovError, Operator};
+use cov_core::{Axis, Cov, CovError, Operator, Spectrum};
 
 /// A smooth interface between media of indices `n1` (incident side) and `n2`.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -119,7 +119,7 @@ impl Refract {
 }
 
 impl<const N: usize> Operator<N> for Refract {
-    fn apply(&self, cov: &mut Cov<N>) -> Result<(), CovError> {
+    fn apply(&self, cov: &mut dyn Spectrum<N>) -> Result<(), CovError> {
         cov.scale(Axis::X, self.cos_i / self.cos_t)?;
         cov.scale(Axis::U, 1.0 / self.angular_scale())?;
         if Cov::<N>::has(Axis::V) {
@@ -154,7 +154,7 @@ impl RoughRefract {
 }
 
 impl<const N: usize> Operator<N> for RoughRefract {
-    fn apply(&self, cov: &mut Cov<N>) -> Result<(), CovError> {
+    fn apply(&self, cov: &mut dyn Spectrum<N>) -> Result<(), CovError> {
         Operator::<N>::apply(&self.refract, cov)?;
         self.lobe.apply_to(cov)
     }

@@ -75,7 +75,7 @@ pub mod spec;
 
 use std::f64::consts::PI;
 
-use cov_core::{Axis, AxisSet, Cov, CovError, FOUR_PI_SQ, NYQUIST_K, Operator};
+use cov_core::{Axis, AxisSet, Cov, CovError, FOUR_PI_SQ, NYQUIST_K, Operator, Spectrum};
 use serde::{Deserialize, Serialize};
 
 /// Parameters of a [`Sensor`] (see the crate docs for units and defaults).
@@ -211,7 +211,7 @@ impl Sensor {
         &self.p
     }
 
-    fn pixel_filter<const N: usize>(&self, cov: &mut Cov<N>) -> Result<(), CovError> {
+    fn pixel_filter<const N: usize>(&self, cov: &mut dyn Spectrum<N>) -> Result<(), CovError> {
         let s = self.p.filter * self.pitch;
         let w = 1.0 / (FOUR_PI_SQ * s * s);
         for &a in Cov::<N>::spatial_axes() {
@@ -354,7 +354,7 @@ fn scaled_block<const N: usize>(
 }
 
 impl<const N: usize> Operator<N> for Sensor {
-    fn apply(&self, cov: &mut Cov<N>) -> Result<(), CovError> {
+    fn apply(&self, cov: &mut dyn Spectrum<N>) -> Result<(), CovError> {
         self.pixel_filter(cov)?;
         let mut rest: Vec<Axis> = Cov::<N>::direction_axes().to_vec();
         if Cov::<N>::has(Axis::T) {
@@ -392,7 +392,7 @@ impl Integrate {
 }
 
 impl<const N: usize> Operator<N> for Integrate {
-    fn apply(&self, cov: &mut Cov<N>) -> Result<(), CovError> {
+    fn apply(&self, cov: &mut dyn Spectrum<N>) -> Result<(), CovError> {
         cov.integrate(&self.axes)
     }
     fn name(&self) -> &str {

@@ -42,7 +42,7 @@
 
 pub mod spec;
 
-use cov_core::{Cov, CovError, Operator};
+use cov_core::{Cov, CovError, Operator, Spectrum};
 
 /// Travel by `distance` metres along the ray.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -68,7 +68,7 @@ impl Travel {
 }
 
 impl<const N: usize> Operator<N> for Travel {
-    fn apply(&self, cov: &mut Cov<N>) -> Result<(), CovError> {
+    fn apply(&self, cov: &mut dyn Spectrum<N>) -> Result<(), CovError> {
         for &(p, d) in Cov::<N>::transverse_pairs() {
             cov.shear(p, d, -self.distance)?;
         }

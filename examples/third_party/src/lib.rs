@@ -4,7 +4,7 @@
 //! Nothing in the covtrace crates knows about it: [`register`] adds it to a registry.
 
 use covtrace::path::{OperatorSpec, Param, Registry};
-use covtrace::{Cov, CovError, FOUR_PI_SQ, Operator};
+use covtrace::{Cov, CovError, FOUR_PI_SQ, Operator, Spectrum};
 use serde::Deserialize;
 
 /// The operator.
@@ -15,7 +15,7 @@ pub struct Sparkle {
 }
 
 impl<const N: usize> Operator<N> for Sparkle {
-    fn apply(&self, cov: &mut Cov<N>) -> Result<(), CovError> {
+    fn apply(&self, cov: &mut dyn Spectrum<N>) -> Result<(), CovError> {
         for &x in Cov::<N>::spatial_axes() {
             cov.add_variance(x, self.window)?;
         }

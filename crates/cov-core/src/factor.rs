@@ -1,0 +1,494 @@
+//! The square-root form of the spectrum covariance: `Σ = L Lᵀ`, with `L` an `N × N`
+//! factor that is updated in place of Σ (the array algorithms of square-root Kalman
+//! filtering).
+//!
+//! Why: a chain that turns Σ into a frame where one block dwarfs another (a curvature
+//! before a lobe and its inverse after, say) and back loses, in the covariance form, the
+//! small block's digits to cancellation: the error grows like `ε · Σ_big/Σ_small` per
+//! event. The factor holds `√Σ`, so the same cancellation costs `ε · √(Σ_big/Σ_small)`,
+//! and Σ = L Lᵀ is symmetric and PSD by construction. The stiff suite (`cov-stiff`)
+//! measures the difference; see the README's numerical-stability section.
+//!
+//! The rules, on `L` (rows are axes, columns are independent "sources"):
+//!
+//! - rule 1, `Σ' = Aᵀ Σ A`: `L' = Aᵀ L` (a shear adds one row to another);
+//! - rule 2, `Σ' = Σ + W`: append the columns of a factor of `W`, then fold the factor
+//!   back to `N` columns with Householder reflections from the right (an LQ step);
+//! - rule 3, `Σ' = Σ − Σ Pᵀ (S + PΣPᵀ)⁻¹ P Σ`: the pre-array `[[√S, P L], [0, L]]` is
+//!   brought to `[[α, 0], [β, L']]` by reflections from the right; then `α αᵀ = S + PΣPᵀ`,
+//!   `β αᵀ = Σ Pᵀ`, and `L' L'ᵀ` is the update. Nothing is inverted, not even `α`;
+//! - rule 4 is rule 3 with `S = 0`.
+
+use nalgebra::SMatrix;
+
+use crate::kernels::{SCHUR_SNAP, block_from_slice, resolve};
+use crate::linalg::{MAX, Small, sym_eigen};
+use crate::{Axis, Cov, CovError};
+
+/// Columns of the largest pre-array: `N` plus up to `N` appended or lobe columns.
+const W: usize = 2 * MAX;
+
+/// A work array for the reflections (`rows × cols` used).
+type Work = [[f64; W]; W];
+
+/// Σ in square-root form: `Σ = L Lᵀ`, `L` an `N × N` real matrix, row `i` for axis `i`.
+///
+/// Every [`Cov`] has a factor ([`CovFactor::from_cov`], a pivoted Cholesky that accepts
+/// singular Σ), and every factor gives back a PSD Σ ([`CovFactor::to_cov`]). The factor
+/// is not unique (any `L Q` with `Q` orthogonal is the same Σ); only Σ is compared.
+///
+/// ```
+/// use cov_core::{Axis, Cov, CovError, CovFactor};
+///
+/// let start = Cov::<2>::gaussian([1e-3, 0.05])?;
+/// let mut f = CovFactor::from_cov(&start);
+/// f.shear(Axis::X, Axis::U, -0.5)?; // travel 0.5 m
+/// f.convolve(&[Axis::U], &[100.0])?; // a glossy lobe
+/// let mut c = start;
+/// c.shear(Axis::X, Axis::U, -0.5)?;
+/// c.convolve(&[Axis::U], &[100.0])?;
+/// approx::assert_relative_eq!(f.to_cov()?, c, max_relative = 1e-12);
+/// # Ok::<(), CovError>(())
+/// ```
+#[derive(Clone, Copy, PartialEq)]
+pub struct CovFactor<const N: usize> {
+    l: [[f64; N]; N],
+}
+
+impl<const N: usize> std::fmt::Debug for CovFactor<N> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("CovFactor").field("l", &self.l).finish()
+    }
+}
+
+impl<const N: usize> Default for CovFactor<N> {
+    fn default() -> Self {
+        Self::zeros()
+    }
+}
+
+impl<const N: usize> CovFactor<N> {
+    /// The factor of Σ = 0.
+    pub fn zeros() -> Self {
+        CovFactor { l: [[0.0; N]; N] }
+    }
+
+    /// A factor with the given rows (`Σ = L Lᵀ`).
+    ///
+    /// # Errors
+    /// A non-finite entry.
+    pub fn from_rows(l: [[f64; N]; N]) -> Result<Self, CovError> {
+        let f = CovFactor { l };
+        f.check_finite("CovFactor::from_rows")?;
+        Ok(f)
+    }
+
+    /// The factor's rows.
+    pub fn rows(&self) -> &[[f64; N]; N] {
+        &self.l
+    }
+
+    /// A factor of `c` by Cholesky with diagonal pivoting on the diagonally scaled Σ, so
+    /// the result does not depend on the axes' units and entries from `1e-300` to
+    /// `1e300` neither overflow nor underflow. Singular Σ is fine: the factorisation stops
+    /// at the first pivot that is not positive (what remains is rounding, at most a few ε
+    /// of the scaled diagonal), leaving zero columns.
+    pub fn from_cov(c: &Cov<N>) -> Self {
+        let mut d = [0.0; N];
+        let mut act = [0usize; N];
+        let mut na = 0;
+        for i in 0..N {
+            let v = c.get(i, i);
+            if v > 0.0 {
+                d[i] = v.sqrt();
+                act[na] = i;
+                na += 1;
+            }
+        }
+        // Scaled (unit diagonal) active block.
+        let mut a = [[0.0; N]; N];
+        for x in 0..na {
+            for y in 0..na {
+                let (i, j) = (act[x], act[y]);
+                a[x][y] = if x == y { 1.0 } else { (c.get(i, j) / d[i]) / d[j] };
+            }
+        }
+        let mut g = [[0.0; N]; N];
+        let mut done = [false; N];
+        for k in 0..na {
+            let mut p = usize::MAX;
+            for x in 0..na {
+                if !done[x] && (p == usize::MAX || a[x][x] > a[p][p]) {
+                    p = x;
+                }
+            }
+            // `p` is set: `na − k ≥ 1` rows are not done.
+            let piv = a[p][p];
+            if piv.is_nan() || piv <= 0.0 {
+                break;
+            }
+            let r = piv.sqrt();
+            done[p] = true;
+            for y in 0..na {
+                if y == p {
+                    g[y][k] = r;
+                } else if !done[y] {
+                    g[y][k] = a[y][p] / r;
+                }
+            }
+            for y in 0..na {
+                for z in 0..na {
+                    if !done[y] && !done[z] {
+                        a[y][z] -= g[y][k] * g[z][k];
+                    }
+                }
+            }
+        }
+        let mut l = [[0.0; N]; N];
+        for x in 0..na {
+            for k in 0..na {
+                l[act[x]][k] = d[act[x]] * g[x][k];
+            }
+        }
+        CovFactor { l }
+    }
+
+    /// Σ = L Lᵀ, exactly symmetric and PSD up to the rounding of the products.
+    ///
+    /// # Errors
+    /// [`CovError::Overflow`] when an entry of Σ exceeds the f64 range (the factor holds
+    /// √Σ, so it can carry entries up to about `1e308` where Σ would be `1e616`).
+    pub fn to_cov(&self) -> Result<Cov<N>, CovError> {
+        let mut c = Cov::<N>::zeros();
+        for i in 0..N {
+            for j in i..N {
+                c.set(i, j, self.dot(i, j));
+            }
+        }
+        c.check_finite("CovFactor::to_cov")?;
+        Ok(c)
+    }
+
+    /// Entry `(i, j)` of Σ.
+    pub fn get(&self, i: usize, j: usize) -> f64 {
+        self.dot(i, j)
+    }
+
+    #[inline]
+    fn dot(&self, i: usize, j: usize) -> f64 {
+        (0..N).map(|c| self.l[i][c] * self.l[j][c]).sum()
+    }
+
+    /// Checks every entry of the factor is finite.
+    ///
+    /// # Errors
+    /// [`CovError::Overflow`] naming `operator` and the row and column of the first
+    /// non-finite entry of `L`.
+    pub fn check_finite(&self, operator: &str) -> Result<(), CovError> {
+        for i in 0..N {
+            for c in 0..N {
+                if !self.l[i][c].is_finite() {
+                    return Err(CovError::Overflow {
+                        operator: operator.into(),
+                        row: i,
+                        col: c,
+                        value: self.l[i][c],
+                    });
+                }
+            }
+        }
+        Ok(())
+    }
+
+    fn commit(&mut self, op: &str, new: [[f64; N]; N]) -> Result<(), CovError> {
+        let f = CovFactor { l: new };
+        f.check_finite(op)?;
+        *self = f;
+        Ok(())
+    }
+
+    /// Rule 1: `Σ' = Aᵀ Σ A`, i.e. `L' = Aᵀ L`.
+    ///
+    /// # Errors
+    /// A non-finite entry in `a`, or an overflowing result (Σ is left unchanged).
+    pub fn congruence(&mut self, a: &SMatrix<f64, N, N>) -> Result<(), CovError> {
+        if let Some(v) = a.iter().copied().find(|v| !v.is_finite()) {
+            return Err(CovError::NonFinite {
+                operator: "congruence".into(),
+                parameter: "A".into(),
+                value: v,
+            });
+        }
+        let mut new = [[0.0; N]; N];
+        for (i, row) in new.iter_mut().enumerate() {
+            for (c, v) in row.iter_mut().enumerate() {
+                *v = (0..N).map(|k| a[(k, i)] * self.l[k][c]).sum();
+            }
+        }
+        self.commit("congruence", new)
+    }
+
+    /// Rule 1, elementary shear (as [`Cov::shear`]): row `source` += `s ×` row `target`.
+    ///
+    /// # Errors
+    /// Missing axis, `target == source`, non-finite `s`, overflow.
+    pub fn shear(&mut self, target: Axis, source: Axis, s: f64) -> Result<(), CovError> {
+        CovError::check_finite("shear", "s", s)?;
+        let i = Cov::<N>::index(target)?;
+        let j = Cov::<N>::index(source)?;
+        if i == j {
+            return Err(CovError::Shape {
+                what: "shear".into(),
+                expected: "two different axes".into(),
+                got: format!("{target} and {source}"),
+            });
+        }
+        let mut new = self.l;
+        for c in 0..N {
+            new[j][c] += s * self.l[i][c];
+        }
+        self.commit("shear", new)
+    }
+
+    /// Rule 1, scaling (as [`Cov::scale`]): row `axis` times `c`.
+    ///
+    /// # Errors
+    /// Missing axis, non-finite `c`, overflow.
+    pub fn scale(&mut self, axis: Axis, c: f64) -> Result<(), CovError> {
+        CovError::check_finite("scale", "c", c)?;
+        let i = Cov::<N>::index(axis)?;
+        let mut new = self.l;
+        for v in new[i].iter_mut() {
+            *v *= c;
+        }
+        self.commit("scale", new)
+    }
+
+    /// Rule 1, rotation in the plane of two axes (as [`Cov::rotate`]).
+    ///
+    /// # Errors
+    /// Missing axis, `a == b`, non-finite `angle`.
+    pub fn rotate(&mut self, a: Axis, b: Axis, angle: f64) -> Result<(), CovError> {
+        CovError::check_finite("rotate", "angle", angle)?;
+        let i = Cov::<N>::index(a)?;
+        let j = Cov::<N>::index(b)?;
+        if i == j {
+            return Err(CovError::Shape {
+                what: "rotate".into(),
+                expected: "two different axes".into(),
+                got: format!("{a} and {b}"),
+            });
+        }
+        let (s, c) = angle.sin_cos();
+        self.rotate_rows(i, j, c, s);
+        Ok(())
+    }
+
+    fn rotate_rows(&mut self, i: usize, j: usize, c: f64, s: f64) {
+        for k in 0..N {
+            let (x, y) = (self.l[i][k], self.l[j][k]);
+            self.l[i][k] = c * x + s * y;
+            self.l[j][k] = c * y - s * x;
+        }
+    }
+
+    /// Rotation of the 3D tangent frame (as [`Cov::rotate_frame`]).
+    ///
+    /// # Errors
+    /// [`CovError::MissingAxis`] in flatland; non-finite `angle`.
+    pub fn rotate_frame(&mut self, angle: f64) -> Result<(), CovError> {
+        CovError::check_finite("rotate_frame", "angle", angle)?;
+        let (x, y, u, v) = (
+            Cov::<N>::index(Axis::X)?,
+            Cov::<N>::index(Axis::Y)?,
+            Cov::<N>::index(Axis::U)?,
+            Cov::<N>::index(Axis::V)?,
+        );
+        let (s, c) = angle.sin_cos();
+        self.rotate_rows(x, y, c, s);
+        self.rotate_rows(u, v, c, s);
+        Ok(())
+    }
+
+    /// Rule 2 on one axis (as [`Cov::add_variance`]): a column `√w e_axis` is appended and
+    /// the factor folded back.
+    ///
+    /// # Errors
+    /// Missing axis, `w` negative or non-finite, overflow.
+    pub fn add_variance(&mut self, axis: Axis, w: f64) -> Result<(), CovError> {
+        CovError::check_non_negative("add_variance", "w", w)?;
+        let i = Cov::<N>::index(axis)?;
+        if w == 0.0 {
+            return Ok(());
+        }
+        let mut m = self.work();
+        m[i][N] = w.sqrt();
+        self.fold("add_variance", m, N + 1)
+    }
+
+    /// Rule 2 (as [`Cov::add_window`]): the columns of `W`'s eigen-factor are appended and
+    /// the factor folded back.
+    ///
+    /// # Errors
+    /// Missing or repeated axis, wrong size, `W` not finite, symmetric and PSD; overflow.
+    pub fn add_window(&mut self, axes: &[Axis], w: &[f64]) -> Result<(), CovError> {
+        let (idx, k) = resolve::<N>("add_window", axes)?;
+        let wm = block_from_slice("add_window", "W", k, w)?;
+        let wf = psd_factor(k, &wm);
+        let mut m = self.work();
+        for a in 0..k {
+            for c in 0..k {
+                m[idx[a]][N + c] = wf[a][c];
+            }
+        }
+        self.fold("add_window", m, N + k)
+    }
+
+    /// Rule 3 (as [`Cov::convolve`]) by the array algorithm; no inverse is formed.
+    ///
+    /// # Errors
+    /// Missing or repeated axis, wrong size, `S` not finite/symmetric/PSD; overflow.
+    pub fn convolve(&mut self, axes: &[Axis], s: &[f64]) -> Result<(), CovError> {
+        let (idx, k) = resolve::<N>("convolve", axes)?;
+        let sm = match (k, s) {
+            (1, [s1]) => {
+                // One axis: S is a non-negative number; no eigen-check needed.
+                CovError::check_non_negative("convolve", "S", *s1)?;
+                let mut m = [[0.0; MAX]; MAX];
+                m[0][0] = *s1;
+                m
+            }
+            _ => block_from_slice("convolve", "S", k, s)?,
+        };
+        self.lobe("convolve", &idx[..k], &sm)
+    }
+
+    /// Rule 4 (as [`Cov::integrate`]): rule 3 with `S = 0`; the integrated rows become 0.
+    ///
+    /// # Errors
+    /// Missing or repeated axis.
+    pub fn integrate(&mut self, axes: &[Axis]) -> Result<(), CovError> {
+        let (idx, k) = resolve::<N>("integrate", axes)?;
+        self.lobe("integrate", &idx[..k], &[[0.0; MAX]; MAX])
+    }
+
+    /// The factor in a work array, columns `0..N`.
+    fn work(&self) -> Work {
+        let mut m = [[0.0; W]; W];
+        for i in 0..N {
+            m[i][..N].copy_from_slice(&self.l[i]);
+        }
+        m
+    }
+
+    /// Folds the `N × cols` array `m` back to `N` columns (`L' L'ᵀ = M Mᵀ`).
+    fn fold(&mut self, op: &str, mut m: Work, cols: usize) -> Result<(), CovError> {
+        lq(&mut m, 0, N, N, cols);
+        let mut new = [[0.0; N]; N];
+        for i in 0..N {
+            new[i].copy_from_slice(&m[i][..N]);
+        }
+        self.commit(op, new)
+    }
+
+    fn lobe(&mut self, op: &str, p: &[usize], s: &Small) -> Result<(), CovError> {
+        let k = p.len();
+        let sf = psd_factor(k, s);
+        // Pre-array: rows 0..k = [√S | P L], rows k..k+N = [0 | L].
+        let mut m = [[0.0; W]; W];
+        for a in 0..k {
+            m[a][..k].copy_from_slice(&sf[a][..k]);
+            m[a][k..k + N].copy_from_slice(&self.l[p[a]]);
+        }
+        for i in 0..N {
+            m[k + i][k..k + N].copy_from_slice(&self.l[i]);
+        }
+        lq(&mut m, 0, k, k + N, k + N);
+        let mut new = [[0.0; N]; N];
+        for i in 0..N {
+            new[i].copy_from_slice(&m[k + i][k..k + N]);
+        }
+        // Exact zeros: an axis whose lobe row is 0 (a diffuse lobe, an integrated axis)
+        // has Σ' e_p = Σ Pᵀ (S + PΣPᵀ)⁺ S e_p = 0 analytically. A row that cancelled to
+        // at most SCHUR_SNAP of its norm before is rounding noise (the factor's analogue
+        // of the covariance form's snap, one square root finer).
+        for (a, &pa) in p.iter().enumerate() {
+            if (0..k).all(|b| s[a][b] == 0.0) {
+                new[pa] = [0.0; N];
+            }
+        }
+        for i in 0..N {
+            let before = row_norm(&self.l[i]);
+            if before > 0.0 && row_norm(&new[i]) <= SCHUR_SNAP * before {
+                new[i] = [0.0; N];
+            }
+        }
+        self.commit(op, new)
+    }
+}
+
+fn row_norm<const N: usize>(r: &[f64; N]) -> f64 {
+    let scale = r.iter().fold(0.0f64, |a, v| a.max(v.abs()));
+    if scale == 0.0 || !scale.is_finite() {
+        return scale;
+    }
+    scale * r.iter().map(|v| (v / scale) * (v / scale)).sum::<f64>().sqrt()
+}
+
+/// Triangularises rows `r0..r1` of `m` (columns `r0..cols`) by Householder reflections
+/// applied from the right to rows `r0..rows`: afterwards row `r` has no entry right of
+/// column `r`. Rows above `r0` must already be zero in columns `≥ r0`.
+///
+/// Each reflection is built from the row scaled by its largest entry, so rows anywhere in
+/// `1e-300 … 1e300` neither overflow nor underflow; a zero row is skipped.
+fn lq(m: &mut Work, r0: usize, r1: usize, rows: usize, cols: usize) {
+    for r in r0..r1 {
+        let scale = (r..cols).fold(0.0f64, |a, c| a.max(m[r][c].abs()));
+        if scale == 0.0 {
+            continue;
+        }
+        let mut v = [0.0; W];
+        for c in r..cols {
+            v[c] = m[r][c] / scale;
+        }
+        let norm = (r..cols).map(|c| v[c] * v[c]).sum::<f64>().sqrt();
+        // α = −sign(v_r)·‖v‖ avoids cancellation in v_r − α.
+        let alpha = if v[r] >= 0.0 { -norm } else { norm };
+        v[r] -= alpha;
+        let vv = (r..cols).map(|c| v[c] * v[c]).sum::<f64>();
+        if vv == 0.0 {
+            continue;
+        }
+        for row in m.iter_mut().take(rows).skip(r + 1) {
+            let t = 2.0 * (r..cols).map(|c| row[c] * v[c]).sum::<f64>() / vv;
+            for c in r..cols {
+                row[c] -= t * v[c];
+            }
+        }
+        m[r][r] = alpha * scale;
+        for c in (r + 1)..cols {
+            m[r][c] = 0.0;
+        }
+    }
+}
+
+/// A factor `F` (k × k) of a symmetric PSD block, `F Fᵀ = S`, from its eigenvectors
+/// (negative rounding eigenvalues count as 0). A diagonal block is factored exactly.
+fn psd_factor(k: usize, s: &Small) -> Small {
+    let mut f = [[0.0; MAX]; MAX];
+    let diagonal = (0..k).all(|a| (0..k).all(|b| a == b || s[a][b] == 0.0));
+    if diagonal {
+        for a in 0..k {
+            f[a][a] = s[a][a].max(0.0).sqrt();
+        }
+        return f;
+    }
+    let (vals, vecs) = sym_eigen(k, s);
+    for c in 0..k {
+        let r = vals[c].max(0.0).sqrt();
+        for a in 0..k {
+            f[a][c] = vecs[a][c] * r;
+        }
+    }
+    f
+}
