@@ -24,8 +24,12 @@ pub fn format_evaluation(name: &str, e: &Evaluation) -> String {
     } else {
         "declared"
     };
+    let form = match e.form {
+        covtrace::Form::SquareRoot => "square root (Σ = L Lᵀ)",
+        covtrace::Form::Covariance => "covariance",
+    };
     out.push_str(&format!(
-        "path: {name}\nlayout: {} ({}), {how}\n\n",
+        "path: {name}\nlayout: {} ({}), {how}\nform: {form}\n\n",
         e.layout,
         e.axes.join(",")
     ));

@@ -28,6 +28,10 @@ enum Command {
         /// Print JSON (axis names, every step's matrix, the final matrix).
         #[arg(long)]
         json: bool,
+        /// How Σ is held while tracing: square-root (default, the accurate form) or
+        /// covariance (cheaper kernels).
+        #[arg(long, value_enum, default_value_t = FormArg::SquareRoot)]
+        form: FormArg,
     },
     /// Draw the spectrum ellipses after every step.
     Plot {
@@ -48,6 +52,31 @@ enum Command {
     },
     /// The registered operators and their parameters.
     List,
+    /// The stiff suite: extreme chains in both forms and plain f64 against a
+    /// double-double reference.
+    Stiff {
+        /// Length of the long chains.
+        #[arg(long, default_value_t = 10_000)]
+        length: usize,
+    },
+}
+
+/// `--form` values.
+#[derive(Clone, Copy, clap::ValueEnum)]
+enum FormArg {
+    /// Σ = L Lᵀ, updated by array algorithms.
+    SquareRoot,
+    /// Σ itself.
+    Covariance,
+}
+
+impl From<FormArg> for covtrace::Form {
+    fn from(f: FormArg) -> Self {
+        match f {
+            FormArg::SquareRoot => covtrace::Form::SquareRoot,
+            FormArg::Covariance => covtrace::Form::Covariance,
+        }
+    }
 }
 
 /// Prints a line; a closed pipe (`covtrace list | head`) is not an error.
@@ -109,10 +138,10 @@ fn json_with_decisions(
 fn run(cli: Cli) -> Result<(), String> {
     let registry = covtrace::registry();
     match cli.command {
-        Command::Eval { path, json } => {
+        Command::Eval { path, json, form } => {
             let p = Path::load(&path, &registry).map_err(|e| e.to_string())?;
             let name = path.display().to_string();
-            let e = p.eval().map_err(|e| e.in_file(&name).to_string())?;
+            let e = p.eval_in(form.into()).map_err(|e| e.in_file(&name).to_string())?;
             let decisions = sensor_decisions(&p, &e).map_err(|m| format!("{name}: {m}"))?;
             if json {
                 say!("{}", json_with_decisions(&e, decisions.as_ref()));
@@ -153,6 +182,18 @@ fn run(cli: Cli) -> Result<(), String> {
             bar.finish_and_clear();
             report::chart(&output, &rows).map_err(|e| format!("{output}: {e}"))?;
             say!("chart written to {output}");
+        }
+        Command::Stiff { length } => {
+            let cases = cov_stiff::cases(length);
+            let bar = ProgressBar::new(cases.len() as u64);
+            let mut outcomes = Vec::with_capacity(cases.len());
+            for case in &cases {
+                bar.set_message(case.name.clone());
+                outcomes.push(cov_stiff::run_case(case));
+                bar.inc(1);
+            }
+            bar.finish_and_clear();
+            say!("{}", cov_stiff::report(&outcomes).trim_end());
         }
         Command::List => {
             for e in registry.entries() {

@@ -25,6 +25,15 @@ use crate::kernels::{SCHUR_SNAP, block_from_slice, resolve};
 use crate::linalg::{MAX, Small, sym_eigen};
 use crate::{Axis, Cov, CovError};
 
+/// The factor's rank decision after a Schur update, on row norms (dimensionless): a row
+/// whose norm fell to at most `ROW_SNAP ×` its norm before holds rounding only and becomes
+/// exactly 0. `ROW_SNAP = √SCHUR_SNAP ≈ 1.2e-7`, so `Σ_aa` itself fell to at most
+/// [`SCHUR_SNAP`] of its value: the same decision as the covariance form, in Σ terms.
+/// A finer threshold (`64 ε` on the row) was measured to keep accumulated rounding of
+/// 67 ε as "content", and a later integration along that noise removed 99.9995% of an
+/// unrelated axis (the row's noise lay along it).
+pub const ROW_SNAP: f64 = 1.1920928955078125e-7;
+
 /// Columns of the largest pre-array: `N` plus up to `N` appended or lobe columns.
 const W: usize = 2 * MAX;
 
@@ -91,8 +100,10 @@ impl<const N: usize> CovFactor<N> {
     /// A factor of `c` by Cholesky with diagonal pivoting on the diagonally scaled Σ, so
     /// the result does not depend on the axes' units and entries from `1e-300` to
     /// `1e300` neither overflow nor underflow. Singular Σ is fine: the factorisation stops
-    /// at the first pivot that is not positive (what remains is rounding, at most a few ε
-    /// of the scaled diagonal), leaving zero columns.
+    /// when the largest remaining pivot of the unit-diagonal matrix is at most
+    /// [`SCHUR_SNAP`] (`64 ε`): what remains is rounding (a rank-deficient Σ leaves pivots
+    /// of a few ε, and dividing by their square roots would blow the noise up), so the
+    /// round trip is exact to about `64 ε` in correlation terms, leaving zero columns.
     pub fn from_cov(c: &Cov<N>) -> Self {
         let mut d = [0.0; N];
         let mut act = [0usize; N];
@@ -124,7 +135,7 @@ impl<const N: usize> CovFactor<N> {
             }
             // `p` is set: `na − k ≥ 1` rows are not done.
             let piv = a[p][p];
-            if piv.is_nan() || piv <= 0.0 {
+            if piv.is_nan() || piv <= SCHUR_SNAP {
                 break;
             }
             let r = piv.sqrt();
@@ -391,10 +402,23 @@ impl<const N: usize> CovFactor<N> {
         self.commit(op, new)
     }
 
+    /// Rule 3. A diagonal `S` (the usual lobe, and integration) is done as one-axis
+    /// updates ([`potter`]), which equal the joint update (in information form each adds
+    /// `e_a e_aᵀ/S_aa`). A correlated `S` takes the array algorithm: the pre-array
+    /// `[[√S, P L], [0, L]]` is brought to `[[α, 0], [β, L']]` by Householder reflections
+    /// from the right, so `α αᵀ = S + PΣPᵀ`, `β αᵀ = Σ Pᵀ` and `L' L'ᵀ` is the update;
+    /// it mixes the factor's columns, never its rows (axes), and inverts nothing.
     fn lobe(&mut self, op: &str, p: &[usize], s: &Small) -> Result<(), CovError> {
         let k = p.len();
+        let diagonal = (0..k).all(|a| (0..k).all(|b| a == b || s[a][b] == 0.0));
+        let mut new = self.l;
+        if diagonal {
+            for a in 0..k {
+                potter_axis(&mut new, p[a], s[a][a].max(0.0));
+            }
+            return self.commit(op, new);
+        }
         let sf = psd_factor(k, s);
-        // Pre-array: rows 0..k = [√S | P L], rows k..k+N = [0 | L].
         let mut m = [[0.0; W]; W];
         for a in 0..k {
             m[a][..k].copy_from_slice(&sf[a][..k]);
@@ -404,26 +428,72 @@ impl<const N: usize> CovFactor<N> {
             m[k + i][k..k + N].copy_from_slice(&self.l[i]);
         }
         lq(&mut m, 0, k, k + N, k + N);
-        let mut new = [[0.0; N]; N];
         for i in 0..N {
             new[i].copy_from_slice(&m[k + i][k..k + N]);
-        }
-        // Exact zeros: an axis whose lobe row is 0 (a diffuse lobe, an integrated axis)
-        // has Σ' e_p = Σ Pᵀ (S + PΣPᵀ)⁺ S e_p = 0 analytically. A row that cancelled to
-        // at most SCHUR_SNAP of its norm before is rounding noise (the factor's analogue
-        // of the covariance form's snap, one square root finer).
-        for (a, &pa) in p.iter().enumerate() {
-            if (0..k).all(|b| s[a][b] == 0.0) {
-                new[pa] = [0.0; N];
-            }
-        }
-        for i in 0..N {
+            // Σ e_a = 0 gives Σ' e_a = 0; and a row that cancelled to ROW_SNAP of its norm
+            // holds rounding only (as in `potter_axis`).
             let before = row_norm(&self.l[i]);
-            if before > 0.0 && row_norm(&new[i]) <= SCHUR_SNAP * before {
+            if before == 0.0 || (!p.contains(&i) && row_norm(&new[i]) <= ROW_SNAP * before) {
                 new[i] = [0.0; N];
             }
         }
         self.commit(op, new)
+    }
+}
+
+/// [`potter`] along axis `p`, then the clean-up: a row that cancelled to at most
+/// [`SCHUR_SNAP`] of its norm before is rounding noise (the factor's analogue of the
+/// covariance form's snap, one square root finer) and becomes exactly 0. Row `p` is
+/// exempt: Potter scales it, so a large drop is the lobe's information. The clean-up runs
+/// after every axis, so that a later axis never updates along a noise direction (a zero-`s`
+/// update along noise would remove a random part of every other row).
+fn potter_axis<const N: usize>(l: &mut [[f64; N]; N], p: usize, s: f64) {
+    let before: [f64; N] = std::array::from_fn(|i| row_norm(&l[i]));
+    let mut h = [0.0; N];
+    h[p] = 1.0;
+    potter(l, &h, s, Some(p));
+    for i in 0..N {
+        if i != p && before[i] > 0.0 && row_norm(&l[i]) <= ROW_SNAP * before[i] {
+            l[i] = [0.0; N];
+        }
+    }
+}
+
+/// Potter's square-root update for one lobe direction `h` with spectrum variance `s ≥ 0`:
+/// with `a = Lᵀ h` and `m = s + |a|²`, `L' = L (I − γ a aᵀ)`, `γ = 1/(m + √(s m))`, which
+/// squares to `I − a aᵀ/m`, i.e. `Σ' = Σ − Σ h hᵀ Σ/(s + hᵀΣh)`. `γ` has no cancellation;
+/// when `h` is one axis `p`, row `p` becomes exactly `L_p √(s/m)` (the covariance form's
+/// `Σ_pp s/m`, to relative accuracy; exactly 0 for a diffuse lobe). `a` and `s` are
+/// scaled by `max(|a|, √s)` first, so no square overflows or underflows.
+fn potter<const N: usize>(l: &mut [[f64; N]; N], h: &[f64; N], s: f64, axis: Option<usize>) {
+    let mut a = [0.0; N];
+    for (c, ac) in a.iter_mut().enumerate() {
+        *ac = (0..N).map(|i| h[i] * l[i][c]).sum();
+    }
+    let scale = a.iter().fold(s.sqrt(), |m, v| m.max(v.abs()));
+    if scale == 0.0 || !scale.is_finite() {
+        // No content along h and a diffuse lobe: nothing to remove.
+        return;
+    }
+    for v in a.iter_mut() {
+        *v /= scale;
+    }
+    let sh = (s / scale) / scale;
+    let mh = sh + a.iter().map(|v| v * v).sum::<f64>();
+    let gamma = 1.0 / (mh + (sh * mh).sqrt());
+    let keep = (sh / mh).sqrt();
+    for (i, row) in l.iter_mut().enumerate() {
+        if Some(i) == axis {
+            for v in row.iter_mut() {
+                *v *= keep;
+            }
+            continue;
+        }
+        let d: f64 = row.iter().zip(&a).map(|(x, y)| x * y).sum();
+        let g = gamma * d;
+        for (v, ac) in row.iter_mut().zip(&a) {
+            *v -= g * ac;
+        }
     }
 }
 

@@ -65,7 +65,7 @@ mod spectrum;
 pub use axis::{Axis, AxisSet, axis_index, layout_axes, layout_set};
 pub use cov::{Cov, DIRAC_RELATIVE_SIZE, FOUR_PI_SQ, PSD_RTOL, Validity};
 pub use error::CovError;
-pub use factor::CovFactor;
+pub use factor::{CovFactor, ROW_SNAP};
 pub use kernels::SCHUR_SNAP;
 pub use operator::{Chain, Operator, Step, Trace, check_layout};
 pub use query::{CovBlock, Filter, NYQUIST_K, primal_std_of_spectrum};

@@ -1,10 +1,11 @@
 //! Every kernel against its dense nalgebra reference, at N = 2, 3, 4, 5, for random PSD Σ
-//! (with per-axis unit scales spanning 4 decades) and random parameters; plus symmetry,
-//! PSD preservation and composition laws.
+//! (with per-axis unit scales spanning 4 decades) and random parameters, in both forms
+//! (covariance `Cov` and square-root `CovFactor`); plus symmetry, PSD preservation and
+//! composition laws.
 
 use std::f64::consts::TAU;
 
-use cov_core::{Axis, Cov};
+use cov_core::{Axis, Cov, CovFactor, Form, Spectrum};
 use nalgebra::{DMatrix, SMatrix};
 use proptest::prelude::*;
 
@@ -54,6 +55,26 @@ fn assert_psd_sym<const N: usize>(c: &Cov<N>, what: &str) {
     );
 }
 
+/// Applies `k` to `c` held in `form`; returns Σ afterwards.
+fn run<const N: usize>(
+    form: Form,
+    c: &Cov<N>,
+    k: impl Fn(&mut dyn Spectrum<N>) -> Result<(), cov_core::CovError>,
+) -> Cov<N> {
+    match form {
+        Form::Covariance => {
+            let mut x = *c;
+            k(&mut x).unwrap();
+            x
+        }
+        Form::SquareRoot => {
+            let mut f = CovFactor::from_cov(c);
+            k(&mut f).unwrap();
+            f.to_cov().unwrap()
+        }
+    }
+}
+
 fn axes_subset<const N: usize>(mask: u8) -> Vec<Axis> {
     let all = Cov::<N>::axes();
     let mut v: Vec<Axis> = all
@@ -71,7 +92,14 @@ fn axes_subset<const N: usize>(mask: u8) -> Vec<Axis> {
     v
 }
 
-fn check_all<const N: usize>(l: &[f64], scales: &[f64], params: &[f64], mask: u8, a_entries: &[f64]) {
+fn check_all<const N: usize>(
+    form: Form,
+    l: &[f64],
+    scales: &[f64],
+    params: &[f64],
+    mask: u8,
+    a_entries: &[f64],
+) {
     let c = make_cov::<N>(l, scales, 0.05);
     let s0 = dense(&c);
     let axes = Cov::<N>::axes();
@@ -82,18 +110,16 @@ fn check_all<const N: usize>(l: &[f64], scales: &[f64], params: &[f64], mask: u8
 
     // shear
     let s = params[0];
-    let mut c1 = c;
-    c1.shear(ai, aj, s).unwrap();
+    let c1 = run(form, &c, |x| x.shear(ai, aj, s));
     let mut a = DMatrix::identity(N, N);
     a[(i, j)] = s;
     let e = rel_err(&dense(&c1), &congruence_ref(&s0, &a));
-    assert!(e <= REL, "shear N={N}: {e}");
+    assert!(e <= REL, "shear N={N} {form:?}: {e}");
     assert_psd_sym(&c1, "shear");
 
     // scale
     let k = params[1];
-    let mut c2 = c;
-    c2.scale(ai, k).unwrap();
+    let c2 = run(form, &c, |x| x.scale(ai, k));
     let mut a = DMatrix::identity(N, N);
     a[(i, i)] = k;
     let e = rel_err(&dense(&c2), &congruence_ref(&s0, &a));
@@ -102,8 +128,7 @@ fn check_all<const N: usize>(l: &[f64], scales: &[f64], params: &[f64], mask: u8
 
     // rotate
     let alpha = params[2];
-    let mut c3 = c;
-    c3.rotate(ai, aj, alpha).unwrap();
+    let c3 = run(form, &c, |x| x.rotate(ai, aj, alpha));
     let mut a = DMatrix::identity(N, N);
     a[(i, i)] = alpha.cos();
     a[(i, j)] = -alpha.sin();
@@ -115,8 +140,7 @@ fn check_all<const N: usize>(l: &[f64], scales: &[f64], params: &[f64], mask: u8
 
     // dense congruence
     let am = SMatrix::<f64, N, N>::from_fn(|r, q| a_entries[r * N + q]);
-    let mut c4 = c;
-    c4.congruence(&am).unwrap();
+    let c4 = run(form, &c, |x| x.congruence(&am));
     let ad = DMatrix::from_fn(N, N, |r, q| am[(r, q)]);
     let e = rel_err(&dense(&c4), &congruence_ref(&s0, &ad));
     assert!(e <= REL, "congruence N={N}: {e}");
@@ -129,8 +153,7 @@ fn check_all<const N: usize>(l: &[f64], scales: &[f64], params: &[f64], mask: u8
     let wl = DMatrix::from_fn(kk, kk, |r, q| params[3 + (r * kk + q) % 5]);
     let w = &wl * wl.transpose() * scales[0] + DMatrix::identity(kk, kk) * 0.1;
     let w_flat: Vec<f64> = (0..kk * kk).map(|r| w[(r / kk, r % kk)]).collect();
-    let mut c5 = c;
-    c5.add_window(&sub, &w_flat).unwrap();
+    let c5 = run(form, &c, |x| x.add_window(&sub, &w_flat));
     let mut r5 = s0.clone();
     for a in 0..kk {
         for b in 0..kk {
@@ -142,8 +165,7 @@ fn check_all<const N: usize>(l: &[f64], scales: &[f64], params: &[f64], mask: u8
     assert_psd_sym(&c5, "add_window");
 
     // convolve: Σ − Σ Pᵀ (S + PΣPᵀ)⁻¹ P Σ
-    let mut c6 = c;
-    c6.convolve(&sub, &w_flat).unwrap();
+    let c6 = run(form, &c, |x| x.convolve(&sub, &w_flat));
     let mut p = DMatrix::zeros(kk, N);
     for (a, &ix) in idx.iter().enumerate() {
         p[(a, ix)] = 1.0;
@@ -160,8 +182,7 @@ fn check_all<const N: usize>(l: &[f64], scales: &[f64], params: &[f64], mask: u8
     assert_psd_sym(&c6, "convolve");
 
     // integrate: kept block ((Σ⁻¹)_kk)⁻¹, zero on integrated axes
-    let mut c7 = c;
-    c7.integrate(&sub).unwrap();
+    let c7 = run(form, &c, |x| x.integrate(&sub));
     let inv = s0.clone().try_inverse().unwrap();
     let kept: Vec<usize> = (0..N).filter(|x| !idx.contains(x)).collect();
     let ikk = DMatrix::from_fn(kept.len(), kept.len(), |a, b| inv[(kept[a], kept[b])]);
@@ -175,6 +196,9 @@ fn check_all<const N: usize>(l: &[f64], scales: &[f64], params: &[f64], mask: u8
     let e = (dense(&c7) - &r7).norm() / s0.norm().max(r7.norm());
     assert!(e <= REL, "integrate N={N}: {e}");
     assert_psd_sym(&c7, "integrate");
+    if form == Form::SquareRoot {
+        return;
+    }
     // The query form agrees with the in-place form.
     let kept_axes: Vec<Axis> = kept.iter().map(|x| axes[*x]).collect();
     let block = c.integrated(&kept_axes).unwrap();
@@ -249,19 +273,23 @@ proptest! {
 
     #[test]
     fn kernels_match_dense_n2(l in entries(25), sc in unit_scales(), p in params(), m in 0u8..32, a in entries(25)) {
-        check_all::<2>(&l, &sc, &p, m, &a);
+        check_all::<2>(Form::Covariance, &l, &sc, &p, m, &a);
+        check_all::<2>(Form::SquareRoot, &l, &sc, &p, m, &a);
     }
     #[test]
     fn kernels_match_dense_n3(l in entries(25), sc in unit_scales(), p in params(), m in 0u8..32, a in entries(25)) {
-        check_all::<3>(&l, &sc, &p, m, &a);
+        check_all::<3>(Form::Covariance, &l, &sc, &p, m, &a);
+        check_all::<3>(Form::SquareRoot, &l, &sc, &p, m, &a);
     }
     #[test]
     fn kernels_match_dense_n4(l in entries(25), sc in unit_scales(), p in params(), m in 0u8..32, a in entries(25)) {
-        check_all::<4>(&l, &sc, &p, m, &a);
+        check_all::<4>(Form::Covariance, &l, &sc, &p, m, &a);
+        check_all::<4>(Form::SquareRoot, &l, &sc, &p, m, &a);
     }
     #[test]
     fn kernels_match_dense_n5(l in entries(25), sc in unit_scales(), p in params(), m in 0u8..32, a in entries(25)) {
-        check_all::<5>(&l, &sc, &p, m, &a);
+        check_all::<5>(Form::Covariance, &l, &sc, &p, m, &a);
+        check_all::<5>(Form::SquareRoot, &l, &sc, &p, m, &a);
     }
 
     #[test]

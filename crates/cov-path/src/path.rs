@@ -2,7 +2,7 @@
 
 use std::fmt;
 
-use cov_core::{Axis, AxisSet, Chain, Cov, CovError, Operator, layout_axes, layout_set};
+use cov_core::{Axis, AxisSet, Chain, Cov, CovError, Form, Operator, layout_axes, layout_set};
 use ron::extensions::Extensions;
 use serde::de::{
     self, DeserializeSeed, Deserializer, EnumAccess, MapAccess, SeqAccess, VariantAccess, Visitor,
@@ -373,17 +373,26 @@ impl Path {
         }
     }
 
-    /// Traces the path: Σ after every step, in the resolved layout.
+    /// Traces the path: Σ after every step, in the resolved layout, holding Σ in the
+    /// default (square-root) form.
     ///
     /// # Errors
     /// Layout mismatch, invalid source, or a failing step (named with its index).
     pub fn eval(&self) -> Result<Evaluation, PathError> {
+        self.eval_in(Form::default())
+    }
+
+    /// [`Path::eval`] holding Σ in `form` along the way.
+    ///
+    /// # Errors
+    /// As [`Path::eval`].
+    pub fn eval_in(&self, form: Form) -> Result<Evaluation, PathError> {
         let (n, inferred) = self.resolve_layout()?;
         match n {
-            2 => self.eval_n::<2>(inferred),
-            3 => self.eval_n::<3>(inferred),
-            4 => self.eval_n::<4>(inferred),
-            _ => self.eval_n::<5>(inferred),
+            2 => self.eval_n::<2>(inferred, form),
+            3 => self.eval_n::<3>(inferred, form),
+            4 => self.eval_n::<4>(inferred, form),
+            _ => self.eval_n::<5>(inferred, form),
         }
     }
 
@@ -396,12 +405,12 @@ impl Path {
         c
     }
 
-    fn eval_n<const N: usize>(&self, inferred: bool) -> Result<Evaluation, PathError> {
+    fn eval_n<const N: usize>(&self, inferred: bool, form: Form) -> Result<Evaluation, PathError> {
         let start = self
             .source
             .covariance::<N>()
             .map_err(|e| PathError::eval(format!("source: {e}")))?;
-        let trace = self.chain::<N>().trace(start).map_err(|e| {
+        let trace = self.chain::<N>().trace_in(form, start).map_err(|e| {
             let at = match &e {
                 CovError::Step { index, .. } => self.positions.get(*index).copied(),
                 _ => None,
@@ -413,6 +422,7 @@ impl Path {
         Ok(Evaluation {
             layout: N,
             inferred,
+            form,
             axes: Cov::<N>::axes().iter().map(|a| a.name().to_string()).collect(),
             start: to_rows(&trace.start),
             steps: trace
@@ -445,6 +455,9 @@ pub struct Evaluation {
     pub layout: usize,
     /// Whether N was inferred (not declared in the file).
     pub inferred: bool,
+    /// The form Σ was held in while tracing.
+    #[serde(default)]
+    pub form: Form,
     /// Axis names in order.
     pub axes: Vec<String>,
     /// Σ of the source.

@@ -6,7 +6,9 @@
 //! refraction a hair above the critical angle, a Dirac source, chains of `10⁴` operators,
 //! rank-deficient Σ, entries from `1e-300` to `1e300`), each evaluated three ways:
 //!
-//! - **ours**: the operator crates on `Cov<N>` (packed kernels, stable forms);
+//! - **ours**: the operator crates through `Chain::eval`, in the default square-root form
+//!   ([`cov_core::Form::SquareRoot`]), and again in the covariance form
+//!   ([`cov_core::Form::Covariance`]: packed kernels with cancellation-free lobe forms);
 //! - **plain**: the textbook formulas in dense f64 with nalgebra (`AᵀΣA`, and for lobes
 //!   `Σ − ΣPᵀ(S + PΣPᵀ)⁻¹PΣ` with `try_inverse`), as a straightforward implementation
 //!   would write them;
@@ -25,7 +27,7 @@ pub mod reference;
 use std::f64::consts::PI;
 
 use cov_brdf::{Brdf, Lobe};
-use cov_core::{Chain, Cov, CovError};
+use cov_core::{Chain, Cov, CovError, Form};
 use cov_curvature::Curvature;
 use cov_projection::{Project, Unproject};
 use cov_refraction::Refract;
@@ -84,8 +86,11 @@ pub struct Outcome {
     pub well_posed: bool,
     /// A typed error is the right answer.
     pub expect_error: bool,
-    /// Relative error of ours against the reference (`None`: ours returned an error).
+    /// Relative error of ours (default, square-root form) against the reference (`None`:
+    /// ours returned an error).
     pub ours: Option<f64>,
+    /// The same in the covariance form (`None`: an error).
+    pub ours_cov: Option<f64>,
     /// Ours returned a non-PSD Σ.
     pub ours_non_psd: bool,
     /// Ours' error message, if it failed.
@@ -237,19 +242,19 @@ pub fn plain_eval(case: &Case) -> Option<DMatrix<f64>> {
     Some(s)
 }
 
-/// The chain through the operator crates.
+/// The chain through the operator crates, holding Σ in `form`.
 ///
 /// # Errors
 /// An operator's error (e.g. overflow, total internal reflection).
-pub fn ours_eval(case: &Case) -> Result<DMatrix<f64>, CovError> {
+pub fn ours_eval(case: &Case, form: Form) -> Result<DMatrix<f64>, CovError> {
     match case.n {
-        2 => ours_n::<2>(case),
-        3 => ours_n::<3>(case),
-        _ => ours_n::<4>(case),
+        2 => ours_n::<2>(case, form),
+        3 => ours_n::<3>(case, form),
+        _ => ours_n::<4>(case, form),
     }
 }
 
-fn ours_n<const N: usize>(case: &Case) -> Result<DMatrix<f64>, CovError> {
+fn ours_n<const N: usize>(case: &Case, form: Form) -> Result<DMatrix<f64>, CovError> {
     let m = nalgebra::SMatrix::<f64, N, N>::from_fn(|i, j| case.start[i * N + j]);
     let start = Cov::<N>::from_matrix(&m)?;
     let mut chain = Chain::<N>::new();
@@ -273,7 +278,7 @@ fn ours_n<const N: usize>(case: &Case) -> Result<DMatrix<f64>, CovError> {
             }
         }
     }
-    let c = chain.eval(start)?;
+    let c = chain.eval_in(form, start)?;
     if !c.validity().psd {
         return Err(CovError::NotPsd {
             min_eigenvalue: c.validity().min_eigenvalue,
@@ -342,11 +347,21 @@ fn is_psd(m: &DMatrix<f64>) -> bool {
 pub fn run_case(case: &Case) -> Outcome {
     let (rd, peak) = dense_eval_peak::<TwoFloat>(case);
     let r = DMatrix::from_row_slice(case.n, case.n, &rd.to_f64());
-    let (ours, ours_non_psd, ours_error) = match ours_eval(case) {
-        Ok(m) => (Some(rel_error(&m, &r, &peak)), !is_psd(&m), None),
-        Err(e @ CovError::NotPsd { .. }) => (None, true, Some(e.to_string())),
-        Err(e) => (None, false, Some(e.to_string())),
+    let mut ours_non_psd = false;
+    let mut ours_error = None;
+    let mut ours_in = |form| match ours_eval(case, form) {
+        Ok(m) => {
+            ours_non_psd |= !is_psd(&m);
+            Some(rel_error(&m, &r, &peak))
+        }
+        Err(e) => {
+            ours_non_psd |= matches!(e, CovError::NotPsd { .. });
+            ours_error.get_or_insert(e.to_string());
+            None
+        }
     };
+    let ours = ours_in(Form::SquareRoot);
+    let ours_cov = ours_in(Form::Covariance);
     let mut perturbed = case.clone();
     for (k, v) in perturbed.start.iter_mut().enumerate() {
         *v *= 1.0 + 1e-12 * if k % 3 == 0 { 1.0 } else { -0.7 };
@@ -363,6 +378,7 @@ pub fn run_case(case: &Case) -> Outcome {
         well_posed: case.well_posed,
         expect_error: case.expect_error,
         ours,
+        ours_cov,
         ours_non_psd,
         ours_error,
         plain,
@@ -614,20 +630,22 @@ pub fn cases(long: usize) -> Vec<Case> {
 /// The report as text lines.
 pub fn report(outcomes: &[Outcome]) -> String {
     let mut s = format!(
-        "{:<50} {:>6} {:>12} {:>9} {:>12} {:>9} {:>10}\n",
-        "case", "ops", "ours err", "ours PSD", "plain err", "plain PSD", "cond"
+        "{:<50} {:>6} {:>11} {:>11} {:>9} {:>11} {:>9} {:>8}\n",
+        "case", "ops", "ours sqrt", "ours cov", "ours PSD", "plain", "plain PSD", "cond"
     );
     let fmt = |e: Option<f64>| e.map(|v| format!("{v:.2e}")).unwrap_or_else(|| "FAILED".into());
+    let ours_cell = |o: &Outcome, e: Option<f64>| match (e, o.expect_error) {
+        (None, true) => "typed err".to_string(),
+        (None, false) => "error".to_string(),
+        (Some(_), _) => fmt(e),
+    };
     for o in outcomes {
         s.push_str(&format!(
-            "{:<50} {:>6} {:>12} {:>9} {:>12} {:>9} {:>10.1e}\n",
+            "{:<50} {:>6} {:>11} {:>11} {:>9} {:>11} {:>9} {:>8.1e}\n",
             o.name,
             o.ops,
-            match (&o.ours_error, o.expect_error) {
-                (Some(_), true) => "typed err".to_string(),
-                (Some(_), false) => "error".to_string(),
-                (None, _) => fmt(o.ours),
-            },
+            ours_cell(o, o.ours),
+            ours_cell(o, o.ours_cov),
             if o.ours_non_psd { "NO" } else { "yes" },
             if o.expect_error {
                 "n/a".to_string()

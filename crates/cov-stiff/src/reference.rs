@@ -124,7 +124,8 @@ impl<R: Real> Dense<R> {
     }
 
     /// Rule 3 on one axis `p` with lobe spectrum `s` (`s = 0`: diffuse, i.e. rule 4):
-    /// `Σ − Σ e_p e_pᵀ Σ / (s + Σ_pp)`; a zero denominator (no content, diffuse lobe)
+    /// `Σ − Σ e_p e_pᵀ Σ / (s + Σ_pp)`, with row and column `p` as `Σ_ip s/(s + Σ_pp)`
+    /// (the same number); a zero denominator (no content, diffuse lobe)
     /// leaves the other axes and clears `p`.
     pub fn lobe(&mut self, p: usize, s: f64) {
         let n = self.n;
@@ -137,10 +138,39 @@ impl<R: Real> Dense<R> {
             return;
         }
         let col: Vec<R> = (0..n).map(|k| self.at(k, p)).collect();
+        let t = R::of(s).div_full(m);
         for i in 0..n {
             for j in 0..n {
-                // col_i · (col_j / m): no intermediate of size Σ², which overflows at 1e300.
-                let v = self.at(i, j) - col[i] * col[j].div_full(m);
+                // Row and column p by the identity Σ_ip − Σ_ip Σ_pp/m = Σ_ip s/m, which
+                // keeps them to relative precision when Σ_pp ≫ s (the difference would
+                // lose them even in double-double at 1e300); elsewhere col_i · (col_j/m):
+                // no intermediate of size Σ², which overflows at 1e300.
+                let v = if i == p || j == p {
+                    col[if i == p { j } else { i }] * t
+                } else {
+                    self.at(i, j) - col[i] * col[j].div_full(m)
+                };
+                self.set(i, j, v);
+            }
+        }
+    }
+
+    /// Rule 3 on two axes `p, q` with a correlated lobe spectrum `S` (row-major 2×2):
+    /// `Σ − Σ Pᵀ (S + PΣPᵀ)⁻¹ P Σ` with the 2×2 inverse by its adjugate. A singular
+    /// `S + PΣPᵀ` is not handled (callers keep `S` positive definite).
+    pub fn lobe2(&mut self, p: usize, q: usize, s: [f64; 4]) {
+        let n = self.n;
+        let m00 = R::of(s[0]) + self.at(p, p);
+        let m01 = R::of(s[1]) + self.at(p, q);
+        let m11 = R::of(s[3]) + self.at(q, q);
+        let det = m00 * m11 - m01 * m01;
+        let (i00, i01, i11) = (m11.div_full(det), (-m01).div_full(det), m00.div_full(det));
+        let cp: Vec<R> = (0..n).map(|k| self.at(k, p)).collect();
+        let cq: Vec<R> = (0..n).map(|k| self.at(k, q)).collect();
+        for i in 0..n {
+            for j in 0..n {
+                let corr = cp[i] * (i00 * cp[j] + i01 * cq[j]) + cq[i] * (i01 * cp[j] + i11 * cq[j]);
+                let v = self.at(i, j) - corr;
                 self.set(i, j, v);
             }
         }
