@@ -1,10 +1,13 @@
 //! # cov-cli: the `covtrace` command line
 //!
-//! - `covtrace eval PATH.ron [--json]`: Σ after every step (axis names, bandwidths); with
-//!   `--json`, the axis names, each step's operator and full matrix, and the final matrix,
-//!   readable back with `cov_path::Evaluation::from_json`.
+//! - `covtrace eval PATH.ron [--json] [--form square-root|covariance]`: Σ after every step
+//!   (axis names, bandwidths); with `--json`, the axis names, each step's operator and full
+//!   matrix, and the final matrix, readable back with `cov_path::Evaluation::from_json`.
+//!   `--form` chooses how Σ is held while tracing (default: square root, the accurate one).
 //! - `covtrace plot PATH.ron -o FILE.png`: the spectrum ellipses after each step.
 //! - `covtrace validate [--full] [-o FILE.svg]`: the brute-force error-against-run-time report.
+//! - `covtrace stiff [--length N]`: the stiff suite (cov-stiff): extreme chains in both
+//!   forms and in plain f64, against a double-double reference.
 //! - `covtrace list`: the registered operators with their parameters and units.
 //!
 //! Every error is one line, `file:line:column: message`, with exit code 2.

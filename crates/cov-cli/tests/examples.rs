@@ -53,6 +53,40 @@ fn every_bundled_path_evaluates_and_round_trips_json() {
 }
 
 #[test]
+fn form_flag_selects_the_form_and_the_json_records_it() {
+    let demo = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../examples/paths/demo.ron");
+    let d = demo.to_str().expect("utf-8");
+    let out = covtrace(&["eval", "--json", "--form", "covariance", d]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let e = Evaluation::from_json(&String::from_utf8_lossy(&out.stdout)).expect("JSON reads back");
+    assert_eq!(e.form, covtrace::Form::Covariance);
+    let direct = covtrace::path::Path::load(&demo, &covtrace::registry())
+        .and_then(|x| x.eval_in(covtrace::Form::Covariance))
+        .expect("eval");
+    assert_eq!(e, direct);
+    let out = covtrace(&["eval", d]);
+    assert!(String::from_utf8_lossy(&out.stdout).contains("form: square root"));
+    let out = covtrace(&["eval", "--form", "cholesky", d]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("square-root"));
+}
+
+#[test]
+fn stiff_prints_every_case_in_both_forms() {
+    let out = covtrace(&["stiff", "--length", "400"]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        text.lines()
+            .next()
+            .is_some_and(|h| h.contains("ours sqrt") && h.contains("ours cov"))
+    );
+    assert_eq!(text.lines().count(), 1 + cov_stiff::cases(400).len());
+    assert!(text.contains("400 operators (bounces) (N=4)"));
+    assert!(!text.contains("NaN"));
+}
+
+#[test]
 fn plot_writes_a_png() {
     let dir = std::env::temp_dir().join(format!("covtrace-plot-{}", std::process::id()));
     std::fs::create_dir_all(&dir).expect("temp dir");
