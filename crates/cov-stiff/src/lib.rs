@@ -570,6 +570,29 @@ pub fn cases(long: usize) -> Vec<Case> {
             false,
         );
         add(
+            "total internal reflection at critical angle",
+            n,
+            spot.clone(),
+            vec![StiffOp::Refract(1.5, 1.0, cc)],
+            false,
+        );
+        // Near-normal incidence: cosines are inputs (no acos), so cos = 1 − ε is as
+        // harmless as cos = 1.
+        let near_one = 1.0 - f64::EPSILON / 2.0;
+        add(
+            "near-normal incidence, cos = 1 − ε/2",
+            n,
+            spot.clone(),
+            vec![
+                StiffOp::Project(near_one),
+                StiffOp::Phong(100.0),
+                StiffOp::Unproject(near_one),
+                StiffOp::Refract(1.0, 1.5, near_one),
+                StiffOp::Refract(1.5, 1.0, 1.0),
+            ],
+            true,
+        );
+        add(
             "entries 1e-300",
             n,
             correlated(n, 1e-300),
