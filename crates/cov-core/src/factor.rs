@@ -392,8 +392,28 @@ impl<const N: usize> CovFactor<N> {
         m
     }
 
-    /// Folds the `N × cols` array `m` back to `N` columns (`L' L'ᵀ = M Mᵀ`).
+    /// Folds the `N × cols` array `m` back to `N` columns (`L' L'ᵀ = M Mᵀ`). When at most
+    /// `N` columns are non-zero (a rank-deficient Σ has free columns: a source constant
+    /// along an axis, an integrated axis), they are only packed side by side, exactly;
+    /// otherwise Householder reflections from the right triangularise `M`.
     fn fold(&mut self, op: &str, mut m: Work, cols: usize) -> Result<(), CovError> {
+        let mut used = [0usize; W];
+        let mut n_used = 0;
+        for c in 0..cols {
+            if (0..N).any(|i| m[i][c] != 0.0) {
+                used[n_used] = c;
+                n_used += 1;
+            }
+        }
+        if n_used <= N {
+            let mut new = [[0.0; N]; N];
+            for (to, &from) in used[..n_used].iter().enumerate() {
+                for i in 0..N {
+                    new[i][to] = m[i][from];
+                }
+            }
+            return self.commit(op, new);
+        }
         lq(&mut m, 0, N, N, cols);
         let mut new = [[0.0; N]; N];
         for i in 0..N {
@@ -441,70 +461,97 @@ impl<const N: usize> CovFactor<N> {
     }
 }
 
-/// [`potter`] along axis `p`, then the clean-up: a row that cancelled to at most
-/// [`SCHUR_SNAP`] of its norm before is rounding noise (the factor's analogue of the
-/// covariance form's snap, one square root finer) and becomes exactly 0. Row `p` is
-/// exempt: Potter scales it, so a large drop is the lobe's information. The clean-up runs
-/// after every axis, so that a later axis never updates along a noise direction (a zero-`s`
-/// update along noise would remove a random part of every other row).
-fn potter_axis<const N: usize>(l: &mut [[f64; N]; N], p: usize, s: f64) {
-    let before: [f64; N] = std::array::from_fn(|i| row_norm(&l[i]));
-    let mut h = [0.0; N];
-    h[p] = 1.0;
-    potter(l, &h, s, Some(p));
-    for i in 0..N {
-        if i != p && before[i] > 0.0 && row_norm(&l[i]) <= ROW_SNAP * before[i] {
-            l[i] = [0.0; N];
+/// Potter's square-root update for a lobe on axis `p` with spectrum variance `s ≥ 0`:
+/// with `a = L_pᵀ` (row `p`) and `m = s + |a|²`, `L' = L (I − γ a aᵀ)`,
+/// `γ = 1/(m + √(s m))`, which squares to `I − a aᵀ/m`, i.e.
+/// `Σ' = Σ − Σ e_p e_pᵀ Σ/(s + Σ_pp)`. `γ` has no cancellation, and row `p` becomes
+/// exactly `L_p √(s/m)` (the covariance form's `Σ_pp s/m`, to relative accuracy; exactly
+/// 0 for a diffuse lobe). When `|a|² + s` would overflow or underflow, `a` and `s` are
+/// scaled by `max(|a_i|, √s)` first.
+#[inline]
+fn potter<const N: usize>(l: &mut [[f64; N]; N], p: usize, s: f64) {
+    let mut a = l[p];
+    let mut sh = s;
+    let mut mh = s + a.iter().map(|v| v * v).sum::<f64>();
+    if !(mh.is_finite() && mh > 1e-290) {
+        let scale = a.iter().fold(s.sqrt(), |m, v| m.max(v.abs()));
+        if scale == 0.0 || !scale.is_finite() {
+            // No content along p and a diffuse lobe: nothing to remove.
+            return;
         }
+        let inv = 1.0 / scale;
+        for v in a.iter_mut() {
+            *v *= inv;
+        }
+        sh = (s * inv) * inv;
+        mh = sh + a.iter().map(|v| v * v).sum::<f64>();
     }
-}
-
-/// Potter's square-root update for one lobe direction `h` with spectrum variance `s ≥ 0`:
-/// with `a = Lᵀ h` and `m = s + |a|²`, `L' = L (I − γ a aᵀ)`, `γ = 1/(m + √(s m))`, which
-/// squares to `I − a aᵀ/m`, i.e. `Σ' = Σ − Σ h hᵀ Σ/(s + hᵀΣh)`. `γ` has no cancellation;
-/// when `h` is one axis `p`, row `p` becomes exactly `L_p √(s/m)` (the covariance form's
-/// `Σ_pp s/m`, to relative accuracy; exactly 0 for a diffuse lobe). `a` and `s` are
-/// scaled by `max(|a|, √s)` first, so no square overflows or underflows.
-fn potter<const N: usize>(l: &mut [[f64; N]; N], h: &[f64; N], s: f64, axis: Option<usize>) {
-    let mut a = [0.0; N];
-    for (c, ac) in a.iter_mut().enumerate() {
-        *ac = (0..N).map(|i| h[i] * l[i][c]).sum();
-    }
-    let scale = a.iter().fold(s.sqrt(), |m, v| m.max(v.abs()));
-    if scale == 0.0 || !scale.is_finite() {
-        // No content along h and a diffuse lobe: nothing to remove.
-        return;
-    }
-    for v in a.iter_mut() {
-        *v /= scale;
-    }
-    let sh = (s / scale) / scale;
-    let mh = sh + a.iter().map(|v| v * v).sum::<f64>();
     let gamma = 1.0 / (mh + (sh * mh).sqrt());
     let keep = (sh / mh).sqrt();
     for (i, row) in l.iter_mut().enumerate() {
-        if Some(i) == axis {
+        if i == p {
             for v in row.iter_mut() {
                 *v *= keep;
             }
             continue;
         }
-        let d: f64 = row.iter().zip(&a).map(|(x, y)| x * y).sum();
-        let g = gamma * d;
+        let g = gamma * row.iter().zip(&a).map(|(x, y)| x * y).sum::<f64>();
         for (v, ac) in row.iter_mut().zip(&a) {
             *v -= g * ac;
         }
     }
 }
 
+/// [`potter`] along axis `p`, then the clean-up: a row whose norm fell to at most
+/// [`ROW_SNAP`] of its norm before is rounding noise (the covariance form's decision, in
+/// Σ terms) and becomes exactly 0. Row `p` is exempt: Potter scales it, so a large drop is
+/// the lobe's information. The clean-up runs after every axis, so that a later axis never
+/// updates along a noise direction (a zero-`s` update along noise would remove a random
+/// part of every other row).
+#[inline]
+fn potter_axis<const N: usize>(l: &mut [[f64; N]; N], p: usize, s: f64) {
+    let old = *l;
+    potter(l, p, s);
+    for i in 0..N {
+        if i != p && cancelled(&l[i], &old[i]) {
+            l[i] = [0.0; N];
+        }
+    }
+}
+
+/// The plain sum of squares of a row (may overflow to ∞ or underflow: see [`cancelled`]).
+#[inline]
+fn sum_sq<const N: usize>(r: &[f64; N]) -> f64 {
+    r.iter().map(|v| v * v).sum()
+}
+
+/// Whether `row` cancelled to at most [`ROW_SNAP`] of the norm of `before` (a row that
+/// was 0 does not count): compared on squares (`≤ SCHUR_SNAP ×`) when both are in range,
+/// else on scaled norms.
+#[inline]
+fn cancelled<const N: usize>(row: &[f64; N], before: &[f64; N]) -> bool {
+    let (now, was) = (sum_sq(row), sum_sq(before));
+    if was.is_finite() && was > 1e-290 && now.is_finite() {
+        return now <= SCHUR_SNAP * was;
+    }
+    let was = row_norm(before);
+    was > 0.0 && row_norm(row) <= ROW_SNAP * was
+}
+
+#[inline]
 fn row_norm<const N: usize>(r: &[f64; N]) -> f64 {
+    // Fast path: the plain sum of squares, when it neither overflowed nor lost the
+    // smallest entries to underflow (threshold 1e-290, far above the subnormal range).
+    let sq: f64 = r.iter().map(|v| v * v).sum();
+    if sq.is_finite() && sq > 1e-290 {
+        return sq.sqrt();
+    }
     let scale = r.iter().fold(0.0f64, |a, v| a.max(v.abs()));
     if scale == 0.0 || !scale.is_finite() {
         return scale;
     }
     scale * r.iter().map(|v| (v / scale) * (v / scale)).sum::<f64>().sqrt()
 }
-
 /// Triangularises rows `r0..r1` of `m` (columns `r0..cols`) by Householder reflections
 /// applied from the right to rows `r0..rows`: afterwards row `r` has no entry right of
 /// column `r`. Rows above `r0` must already be zero in columns `≥ r0`.

@@ -356,7 +356,7 @@ impl<const N: usize> Cov<N> {
     /// `m = s + Σ_pp`, `t = s/m`: `Σ_pp' = Σ_pp t`, `Σ_op' = Σ_op t`,
     /// `Σ_oo' = Σ_oo − Σ_op Σ_po / m`. For `m = 0` (no content and a diffuse lobe) the
     /// generalised inverse is 0 and only the axis itself is cleared.
-    #[inline]
+    #[inline(always)]
     fn lobe_product_1(&mut self, p: usize, s: f64) {
         let mut before = [0.0; N];
         for (i, b) in before.iter_mut().enumerate() {
@@ -397,6 +397,7 @@ impl<const N: usize> Cov<N> {
     /// The convolved axes `p` are exempt unless negative: their entries are products
     /// (`Σ_pp (S+Σ_pp)⁻¹ S`), not differences, so a large drop is information (a lobe of
     /// spectrum `S` on an angular spectrum `Σ_uu ≫ S` leaves `≈ S`), not cancellation.
+    #[inline(always)]
     fn snap_cancelled(&mut self, before: &[f64; N], p: &[usize]) {
         for a in 0..N {
             let v = self.get(a, a);

@@ -41,7 +41,7 @@
 //! Operators act through the [`Spectrum`] interface, so a [`Chain`] holds Σ in either
 //! [`Form`]: the square-root [`CovFactor`] (`Σ = L Lᵀ`, the default; PSD by construction,
 //! and a cancelling Schur complement loses `ε·√(Σ_big/Σ_small)` instead of
-//! `ε·Σ_big/Σ_small`: 1.6e-12 against 4.1e-9 on the stiff suite's 10⁴-operator bounce
+//! `ε·Σ_big/Σ_small`: 2.4e-12 against 4.1e-9 on the stiff suite's 10⁴-operator bounce
 //! chains) or the covariance [`Cov`] itself (cheaper kernels). Both make the same rank
 //! decisions ([`SCHUR_SNAP`] on Σ, [`ROW_SNAP`] `= √SCHUR_SNAP` on the factor's rows).
 //!
