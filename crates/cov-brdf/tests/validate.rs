@@ -105,14 +105,7 @@ fn reflect_composite_matches_ground_truth_2d() {
         &mut q,
     )
     .unwrap();
-    let g = f
-        .then(Primal::scale(2, 0, c))
-        .then(Primal::scale(2, 1, -1.0))
-        .then(Primal::shear(2, 1, 0, k))
-        .then(Primal::scale(2, 1, -1.0))
-        .then(Primal::gaussian_lobe(1, 1.0 / e, 129))
-        .then(Primal::shear(2, 1, 0, -k))
-        .then(Primal::scale(2, 0, 1.0 / c));
+    let g = f.then_all(Primal::reflection_2d(c, c, k, 1.0 / e, 129));
     let r = compare(&g, &q, &Grid::auto(&q, 64, &[1.0; 2])).unwrap();
     assert!(r.rel_error < 1e-3, "reflect: {:e}", r.rel_error);
 }

@@ -92,14 +92,7 @@ pub fn cases() -> Result<Vec<Case>, covtrace::CovError> {
                 Curvature::isotropic(2.0)?,
                 Lobe::phong(200.0)?,
             )?),
-            field: f0()
-                .then(Primal::scale(2, 0, 0.8))
-                .then(Primal::scale(2, 1, -1.0))
-                .then(Primal::shear(2, 1, 0, 2.0))
-                .then(Primal::scale(2, 1, -1.0))
-                .then(Primal::gaussian_lobe(1, 1.0 / 200.0, 129))
-                .then(Primal::shear(2, 1, 0, -2.0))
-                .then(Primal::scale(2, 0, 1.0 / 0.8)),
+            field: f0().then_all(Primal::reflection_2d(0.8, 0.8, 2.0, 1.0 / 200.0, 129)),
         },
         Case {
             name: "refraction air→glass",

@@ -95,6 +95,23 @@ impl Primal {
             nodes,
         }
     }
+
+    /// The reflection composite in flatland `(x, u)`, from its primal definition:
+    /// projection onto the surface by `cos_in`, incident directions turned back toward the
+    /// light (`u → −u`), curvature `k` (`u += k x`), `u` turned back, a Gaussian lobe of
+    /// angular variance `lobe_var` (`nodes` quadrature nodes), inverse curvature, and the
+    /// unprojection by `cos_out`. What `cov_brdf::Reflect` must reproduce.
+    pub fn reflection_2d(cos_in: f64, cos_out: f64, k: f64, lobe_var: f64, nodes: usize) -> Vec<Primal> {
+        vec![
+            Primal::scale(2, 0, cos_in),
+            Primal::scale(2, 1, -1.0),
+            Primal::shear(2, 1, 0, k),
+            Primal::scale(2, 1, -1.0),
+            Primal::gaussian_lobe(1, lobe_var, nodes),
+            Primal::shear(2, 1, 0, -k),
+            Primal::scale(2, 0, 1.0 / cos_out),
+        ]
+    }
 }
 
 /// A primal light field: a starting field and the operations applied to it in order.
@@ -141,6 +158,12 @@ impl Field {
     /// Appends an operation.
     pub fn then(mut self, op: Primal) -> Field {
         self.ops.push(op);
+        self
+    }
+
+    /// Appends operations in order (e.g. [`Primal::reflection_2d`]).
+    pub fn then_all(mut self, ops: impl IntoIterator<Item = Primal>) -> Field {
+        self.ops.extend(ops);
         self
     }
 
