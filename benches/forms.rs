@@ -16,23 +16,13 @@ use covtrace::curvature::Curvature;
 use covtrace::occlusion::Window;
 use covtrace::sensor::Integrate;
 use covtrace::travel::Travel;
-use covtrace::{Axis, Chain, Cov, CovFactor, Form, Spectrum};
+use covtrace::{Axis, Chain, CovFactor, Form, Spectrum};
 use criterion::{Criterion, criterion_group, criterion_main};
-use nalgebra::SMatrix;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
-const BATCH: usize = 256;
-
-fn random_covs<const N: usize>(rng: &mut ChaCha8Rng) -> Vec<Cov<N>> {
-    (0..BATCH)
-        .map(|_| {
-            let l = SMatrix::<f64, N, N>::from_fn(|_, _| rng.random_range(-1.0..1.0));
-            let m = l * l.transpose() + SMatrix::<f64, N, N>::identity() * 0.01;
-            Cov::from_matrix(&m).expect("L Lᵀ + εI is PSD")
-        })
-        .collect()
-}
+mod common;
+use common::{BATCH, random_covs};
 
 macro_rules! both {
     ($g:ident, $name:literal, $covs:ident, $facs:ident, $params:ident, |$x:ident, $p:ident| $body:expr) => {

@@ -7,23 +7,14 @@
 
 use std::hint::black_box;
 
-use covtrace::{Axis, Cov};
+use covtrace::Axis;
 use criterion::{Criterion, criterion_group, criterion_main};
 use nalgebra::SMatrix;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
-const BATCH: usize = 256;
-
-fn random_covs<const N: usize>(rng: &mut ChaCha8Rng) -> Vec<Cov<N>> {
-    (0..BATCH)
-        .map(|_| {
-            let l = SMatrix::<f64, N, N>::from_fn(|_, _| rng.random_range(-1.0..1.0));
-            let m = l * l.transpose() + SMatrix::<f64, N, N>::identity() * 0.01;
-            Cov::from_matrix(&m).expect("L Lᵀ + εI is PSD")
-        })
-        .collect()
-}
+mod common;
+use common::{BATCH, random_covs};
 
 fn bench_n<const N: usize>(c: &mut Criterion, rng: &mut ChaCha8Rng) {
     let covs = random_covs::<N>(rng);

@@ -21,7 +21,7 @@
 
 use nalgebra::SMatrix;
 
-use crate::kernels::{SCHUR_SNAP, block_from_slice, resolve};
+use crate::kernels::{SCHUR_SNAP, block_from_slice, resolve, two_axes};
 use crate::linalg::{MAX, Small, sym_eigen};
 use crate::{Axis, Cov, CovError};
 
@@ -245,15 +245,7 @@ impl<const N: usize> CovFactor<N> {
     /// Missing axis, `target == source`, non-finite `s`, overflow.
     pub fn shear(&mut self, target: Axis, source: Axis, s: f64) -> Result<(), CovError> {
         CovError::check_finite("shear", "s", s)?;
-        let i = Cov::<N>::index(target)?;
-        let j = Cov::<N>::index(source)?;
-        if i == j {
-            return Err(CovError::Shape {
-                what: "shear".into(),
-                expected: "two different axes".into(),
-                got: format!("{target} and {source}"),
-            });
-        }
+        let (i, j) = two_axes::<N>("shear", target, source)?;
         let mut new = self.l;
         for c in 0..N {
             new[j][c] += s * self.l[i][c];
@@ -281,15 +273,7 @@ impl<const N: usize> CovFactor<N> {
     /// Missing axis, `a == b`, non-finite `angle`.
     pub fn rotate(&mut self, a: Axis, b: Axis, angle: f64) -> Result<(), CovError> {
         CovError::check_finite("rotate", "angle", angle)?;
-        let i = Cov::<N>::index(a)?;
-        let j = Cov::<N>::index(b)?;
-        if i == j {
-            return Err(CovError::Shape {
-                what: "rotate".into(),
-                expected: "two different axes".into(),
-                got: format!("{a} and {b}"),
-            });
-        }
+        let (i, j) = two_axes::<N>("rotate", a, b)?;
         let (s, c) = angle.sin_cos();
         self.rotate_rows(i, j, c, s);
         Ok(())

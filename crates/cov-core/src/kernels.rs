@@ -76,15 +76,7 @@ impl<const N: usize> Cov<N> {
     #[inline]
     pub fn shear(&mut self, target: Axis, source: Axis, s: f64) -> Result<(), CovError> {
         CovError::check_finite("shear", "s", s)?;
-        let i = Self::index(target)?;
-        let j = Self::index(source)?;
-        if i == j {
-            return Err(CovError::Shape {
-                what: "shear".into(),
-                expected: "two different axes".into(),
-                got: format!("{target} and {source}"),
-            });
-        }
+        let (i, j) = two_axes::<N>("shear", target, source)?;
         if s == 0.0 {
             return Ok(());
         }
@@ -138,15 +130,7 @@ impl<const N: usize> Cov<N> {
     #[inline]
     pub fn rotate(&mut self, a: Axis, b: Axis, angle: f64) -> Result<(), CovError> {
         CovError::check_finite("rotate", "angle", angle)?;
-        let i = Self::index(a)?;
-        let j = Self::index(b)?;
-        if i == j {
-            return Err(CovError::Shape {
-                what: "rotate".into(),
-                expected: "two different axes".into(),
-                got: format!("{a} and {b}"),
-            });
-        }
+        let (i, j) = two_axes::<N>("rotate", a, b)?;
         let (s, c) = angle.sin_cos();
         let old = *self;
         self.rotate_idx(i, j, c, s);
@@ -489,4 +473,17 @@ pub(crate) fn resolve<const N: usize>(op: &str, axes: &[Axis]) -> Result<([usize
         }
     }
     Ok((idx, axes.len()))
+}
+
+/// The indices of two different axes `a`, `b` of layout `N`, for kernel `op`.
+pub(crate) fn two_axes<const N: usize>(op: &str, a: Axis, b: Axis) -> Result<(usize, usize), CovError> {
+    let (i, j) = (Cov::<N>::index(a)?, Cov::<N>::index(b)?);
+    if i == j {
+        return Err(CovError::Shape {
+            what: op.into(),
+            expected: "two different axes".into(),
+            got: format!("{a} and {b}"),
+        });
+    }
+    Ok((i, j))
 }
