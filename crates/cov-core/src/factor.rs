@@ -14,9 +14,11 @@
 //! - rule 1, `Σ' = Aᵀ Σ A`: `L' = Aᵀ L` (a shear adds one row to another);
 //! - rule 2, `Σ' = Σ + W`: append the columns of a factor of `W`, then fold the factor
 //!   back to `N` columns with Householder reflections from the right (an LQ step);
-//! - rule 3, `Σ' = Σ − Σ Pᵀ (S + PΣPᵀ)⁻¹ P Σ`: the pre-array `[[√S, P L], [0, L]]` is
-//!   brought to `[[α, 0], [β, L']]` by reflections from the right; then `α αᵀ = S + PΣPᵀ`,
-//!   `β αᵀ = Σ Pᵀ`, and `L' L'ᵀ` is the update. Nothing is inverted, not even `α`;
+//! - rule 3, `Σ' = Σ − Σ Pᵀ (S + PΣPᵀ)⁻¹ P Σ`: for each axis of a diagonal `S`, Potter's
+//!   update `L' = L (I − γ a aᵀ)` with `a` the axis' row and `γ = 1/(m + √(s m))`; for a
+//!   correlated `S`, the pre-array `[[√S, P L], [0, L]]` brought to `[[α, 0], [β, L']]`
+//!   by reflections from the right (`α αᵀ = S + PΣPᵀ`, `β αᵀ = Σ Pᵀ`). Nothing is
+//!   inverted;
 //! - rule 4 is rule 3 with `S = 0`.
 
 use nalgebra::SMatrix;
