@@ -39,8 +39,8 @@ pub const ROW_SNAP: f64 = 1.1920928955078125e-7;
 /// Columns of the largest pre-array: `N` plus up to `N` appended or lobe columns.
 const W: usize = 2 * MAX;
 
-/// A work array for the reflections (`rows × cols` used).
-type Work = [[f64; W]; W];
+/// A work array for a fold: the factor's `N ≤ 5` rows with up to `2N` columns.
+type Work = [[f64; W]; MAX];
 
 /// Σ in square-root form: `Σ = L Lᵀ`, `L` an `N × N` real matrix, row `i` for axis `i`.
 ///
@@ -371,7 +371,7 @@ impl<const N: usize> CovFactor<N> {
 
     /// The factor in a work array, columns `0..N`.
     fn work(&self) -> Work {
-        let mut m = [[0.0; W]; W];
+        let mut m = [[0.0; W]; MAX];
         for i in 0..N {
             m[i][..N].copy_from_slice(&self.l[i]);
         }
@@ -544,26 +544,35 @@ fn row_norm<const N: usize>(r: &[f64; N]) -> f64 {
 ///
 /// Each reflection is built from the row scaled by its largest entry, so rows anywhere in
 /// `1e-300 … 1e300` neither overflow nor underflow; a zero row is skipped.
-fn lq(m: &mut Work, r0: usize, r1: usize, rows: usize, cols: usize) {
+fn lq<const R: usize>(m: &mut [[f64; W]; R], r0: usize, r1: usize, rows: usize, cols: usize) {
     for r in r0..r1 {
-        let scale = (r..cols).fold(0.0f64, |a, c| a.max(m[r][c].abs()));
-        if scale == 0.0 {
-            continue;
-        }
         let mut v = [0.0; W];
-        for c in r..cols {
-            v[c] = m[r][c] / scale;
+        v[r..cols].copy_from_slice(&m[r][r..cols]);
+        // Scale only when the plain sum of squares would overflow or underflow.
+        let mut scale = 1.0;
+        let mut sq: f64 = v[r..cols].iter().map(|x| x * x).sum();
+        if !(sq.is_finite() && sq > 1e-290) {
+            scale = v[r..cols].iter().fold(0.0f64, |a, x| a.max(x.abs()));
+            if scale == 0.0 {
+                continue;
+            }
+            let inv = 1.0 / scale;
+            for x in v[r..cols].iter_mut() {
+                *x *= inv;
+            }
+            sq = v[r..cols].iter().map(|x| x * x).sum();
         }
-        let norm = (r..cols).map(|c| v[c] * v[c]).sum::<f64>().sqrt();
+        let norm = sq.sqrt();
         // α = −sign(v_r)·‖v‖ avoids cancellation in v_r − α.
         let alpha = if v[r] >= 0.0 { -norm } else { norm };
         v[r] -= alpha;
-        let vv = (r..cols).map(|c| v[c] * v[c]).sum::<f64>();
+        let vv: f64 = v[r..cols].iter().map(|x| x * x).sum();
         if vv == 0.0 {
             continue;
         }
+        let two_over = 2.0 / vv;
         for row in m.iter_mut().take(rows).skip(r + 1) {
-            let t = 2.0 * (r..cols).map(|c| row[c] * v[c]).sum::<f64>() / vv;
+            let t = two_over * (r..cols).map(|c| row[c] * v[c]).sum::<f64>();
             for c in r..cols {
                 row[c] -= t * v[c];
             }
