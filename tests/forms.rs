@@ -120,16 +120,11 @@ const LOCAL: f64 = 1024.0;
 /// in the exact Σ after step k changes the exact final Σ (relative, the stiff measure).
 /// `Σ_k κ_k · LOCAL · ε` bounds the final error of any evaluation that is backward stable
 /// step by step, whichever form it holds Σ in.
-fn conditioning(start: &Dense<TwoFloat>, ops: &[Op]) -> f64 {
-    let n = start.n;
-    let mut states = vec![start.clone()];
-    for &op in ops {
-        let mut d = states[states.len() - 1].clone();
-        reference(&mut d, op);
-        states.push(d);
-    }
+/// `states` are the reference's Σ before the first step and after each of `ops`.
+fn conditioning(states: &[Dense<TwoFloat>], ops: &[Op]) -> f64 {
+    let n = states[0].n;
     let exact = DMatrix::from_row_slice(n, n, &states[ops.len()].to_f64());
-    let peak = peaks(&states);
+    let peak = peaks(states);
     let mut total = 0.0;
     for (k, state) in states.iter().enumerate() {
         let rows = state.to_f64();
@@ -214,7 +209,7 @@ fn run_chain<const N: usize>(
     let exact = DMatrix::from_row_slice(N, N, &r.to_f64());
     let ef = rel_error(&dense(&fac.to_cov().unwrap()), &exact, &peak);
     let ec = rel_error(&dense(&cov), &exact, &peak);
-    let bound = (conditioning(&start, &ops) * LOCAL * f64::EPSILON).max(1e-13);
+    let bound = (conditioning(&states, &ops) * LOCAL * f64::EPSILON).max(1e-13);
     // The covariance form is PSD to its own error: an error of `bound` (relative to the
     // chain's peak) can move an eigenvalue by that much.
     let min = dense(&cov).symmetric_eigen().eigenvalues.min();

@@ -438,8 +438,8 @@ impl<const N: usize> CovFactor<N> {
             new[i].copy_from_slice(&m[k + i][k..k + N]);
             // Σ e_a = 0 gives Σ' e_a = 0; and a row that cancelled to ROW_SNAP of its norm
             // holds rounding only (as in `potter_axis`).
-            let before = row_norm(&self.l[i]);
-            if before == 0.0 || (!p.contains(&i) && row_norm(&new[i]) <= ROW_SNAP * before) {
+            let empty = self.l[i].iter().all(|v| *v == 0.0);
+            if empty || (!p.contains(&i) && cancelled(&new[i], &self.l[i])) {
                 new[i] = [0.0; N];
             }
         }

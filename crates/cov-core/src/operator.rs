@@ -198,10 +198,13 @@ impl<const N: usize> Chain<N> {
     /// As [`Chain::eval_in`].
     pub fn trace_in(&self, form: Form, start: Cov<N>) -> Result<Trace<N>, CovError> {
         let mut cov = start;
-        let mut factor = CovFactor::from_cov(&start);
+        let mut factor: CovFactor<N>;
         let s: &mut dyn Spectrum<N> = match form {
             Form::Covariance => &mut cov,
-            Form::SquareRoot => &mut factor,
+            Form::SquareRoot => {
+                factor = CovFactor::from_cov(&start);
+                &mut factor
+            }
         };
         let mut steps = Vec::with_capacity(self.steps.len());
         for (index, op) in self.steps.iter().enumerate() {
