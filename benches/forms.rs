@@ -73,7 +73,7 @@ fn kernels_n<const N: usize>(c: &mut Criterion, rng: &mut ChaCha8Rng) {
             let mut acc = 0.0;
             for (cv, d) in covs.iter().zip(&params) {
                 let mut x = *cv;
-                let s: &mut dyn Spectrum<N> = black_box(&mut x);
+                let s: &mut dyn Spectrum = black_box(&mut x);
                 s.shear(Axis::X, Axis::U, -d).ok();
                 acc += x.get(0, 0);
             }
@@ -101,7 +101,7 @@ fn kernels_n<const N: usize>(c: &mut Criterion, rng: &mut ChaCha8Rng) {
     g.finish();
 }
 
-fn glossy_path() -> Chain<4> {
+fn glossy_path() -> Chain {
     let reflect = Reflect::new(
         0.8,
         0.9,

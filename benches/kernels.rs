@@ -7,7 +7,7 @@
 
 use std::hint::black_box;
 
-use covtrace::Axis;
+use covtrace::{Axis, Spectrum};
 use criterion::{Criterion, criterion_group, criterion_main};
 use nalgebra::SMatrix;
 use rand::{Rng, SeedableRng};
@@ -44,7 +44,7 @@ fn bench_n<const N: usize>(c: &mut Criterion, rng: &mut ChaCha8Rng) {
                     a[(1, 3)] = -d;
                 }
                 let mut x = *cv;
-                x.congruence(&a).ok();
+                x.congruence(a.transpose().as_slice()).ok();
                 acc += x.get(N - 1, N - 1);
             }
             black_box(acc)

@@ -13,7 +13,7 @@ use covtrace::{Axis, Chain, Cov, CovError, NYQUIST_K, Operator};
 fn main() -> Result<(), CovError> {
     // A 10 cm Gaussian area light, emitting uniformly in angle (constant along u, v).
     let start = Cov::<4>::gaussian([0.1, 0.1, f64::INFINITY, f64::INFINITY])?;
-    let chain = Chain::<4>::new()
+    let chain = Chain::new()
         .with(Travel::new(1.0)?)
         .with(BlockerEdge::new(0.02)?)
         .with(Travel::new(0.5)?)
@@ -63,9 +63,6 @@ fn main() -> Result<(), CovError> {
     Ok(())
 }
 
-fn chain_names(chain: &Chain<4>) -> Vec<String> {
-    chain
-        .operators()
-        .map(|o| Operator::<4>::name(o).to_string())
-        .collect()
+fn chain_names(chain: &Chain) -> Vec<String> {
+    chain.operators().map(|o| Operator::name(o).to_string()).collect()
 }

@@ -11,7 +11,7 @@
 //! and never compiles what it does not use.
 //!
 //! ```
-//! use covtrace::{Axis, Cov, CovError};
+//! use covtrace::{Axis, Cov, CovError, Spectrum};
 //!
 //! let mut c = Cov::<4>::gaussian([1e-3, 1e-3, f64::INFINITY, f64::INFINITY])?;
 //! c.shear(Axis::X, Axis::U, -1.0)?;
@@ -23,7 +23,33 @@
 pub use cov_core::*;
 
 /// RON light paths and the operator registry (crate `cov-path`).
+#[cfg(feature = "path")]
 pub use cov_path as path;
+
+/// Registers every operator compiled in (one feature per operator crate) with `r`.
+pub fn register_all<R: Registrar>(r: &mut R) {
+    let _ = &r;
+    #[cfg(feature = "travel")]
+    cov_travel::spec::register(r);
+    #[cfg(feature = "occlusion")]
+    cov_occlusion::spec::register(r);
+    #[cfg(feature = "projection")]
+    cov_projection::spec::register(r);
+    #[cfg(feature = "curvature")]
+    cov_curvature::spec::register(r);
+    #[cfg(feature = "brdf")]
+    cov_brdf::spec::register(r);
+    #[cfg(feature = "refraction")]
+    cov_refraction::spec::register(r);
+    #[cfg(feature = "motion")]
+    cov_motion::spec::register(r);
+    #[cfg(feature = "defocus")]
+    cov_defocus::spec::register(r);
+    #[cfg(feature = "sensor")]
+    cov_sensor::spec::register(r);
+    #[cfg(feature = "media")]
+    cov_media::spec::register(r);
+}
 
 /// A registry with every operator this build includes (one per enabled feature).
 ///
@@ -37,33 +63,13 @@ pub use cov_path as path;
 /// assert_eq!(result.layout, 2); // inferred: nothing needs y, v or t
 /// # Ok::<(), covtrace::path::PathError>(())
 /// ```
+#[cfg(feature = "path")]
 pub fn registry() -> cov_path::Registry {
-    #[allow(unused_mut)]
     let mut r = cov_path::Registry::new();
-    #[cfg(feature = "travel")]
-    cov_travel::spec::register(&mut r);
-    #[cfg(feature = "occlusion")]
-    cov_occlusion::spec::register(&mut r);
-    #[cfg(feature = "projection")]
-    cov_projection::spec::register(&mut r);
-    #[cfg(feature = "curvature")]
-    cov_curvature::spec::register(&mut r);
-    #[cfg(feature = "brdf")]
-    cov_brdf::spec::register(&mut r);
-    #[cfg(feature = "refraction")]
-    cov_refraction::spec::register(&mut r);
-    #[cfg(feature = "motion")]
-    cov_motion::spec::register(&mut r);
-    #[cfg(feature = "defocus")]
-    cov_defocus::spec::register(&mut r);
-    #[cfg(feature = "sensor")]
-    cov_sensor::spec::register(&mut r);
-    #[cfg(feature = "media")]
-    cov_media::spec::register(&mut r);
+    register_all(&mut r);
     r
 }
 
-/// Free-space travel (crate `cov-travel`, feature `travel`).
 #[cfg(feature = "travel")]
 pub use cov_travel as travel;
 

@@ -10,7 +10,7 @@ use covtrace::{Chain, Cov, Operator};
 
 #[test]
 fn every_operator_in_one_5d_chain() {
-    let chain = Chain::<5>::new()
+    let chain = Chain::new()
         .with(Travel::new(1.0).unwrap())
         .with(BlockerEdge::new(0.1).unwrap())
         .with(RotateFrame::new(0.3).unwrap())
@@ -31,5 +31,5 @@ fn every_operator_in_one_5d_chain() {
     assert!(trace.last().validity().is_valid());
     // Time is untouched by static operators.
     assert_eq!(trace.last().get(4, 4), 0.0);
-    assert_eq!(Operator::<5>::requires(&chain).smallest_layout(), 4);
+    assert_eq!(Operator::requires(&chain).smallest_layout(), 4);
 }

@@ -15,6 +15,18 @@
 //! | [`Lobe::Beckmann`] | `alpha_u`, `alpha_v` | – | ≥ 0 | `2α²`: Beckmann slopes are Gaussian with variance `α²/2`, and a reflected direction turns by twice the slope |
 //! | [`Lobe::Ggx`] | `alpha_u`, `alpha_v` | – | ≥ 0 | `α²`: fit of the curvature at the peak (slope variance `α²/4`, doubled angle); GGX tails are heavy, so this is an approximation whose error the tests measure |
 //!
+//! Parameters, as written in a path file (`covtrace list` prints the same):
+//!
+//! <!-- parameters: generated from the specs (`COVTRACE_BLESS=1 cargo test --test param_tables`) -->
+//! | operator | parameter | unit | default | meaning |
+//! |---|---|---|---|---|
+//! | `Brdf` | `lobe` | – | required | The lobe: `Diffuse`, `Mirror`, `Phong(exponent)`, `Gaussian(var_u, var_v)`, `Beckmann(alpha_u, alpha_v)` or `Ggx(alpha_u, alpha_v)`. |
+//! | `Reflect` | `cos_in` | – | required | `\|cos θ_in\|`, in (0, 1]. |
+//! |  | `cos_out` | – | required | `\|cos θ_out\|`, in (0, 1]. |
+//! |  | `curvature` | 1/m | optional | Surface curvature, `(k: …)` or `(kx: …, ky: …, angle: …)`; flat when left out. |
+//! |  | `lobe` | – | required | The lobe, as in `Brdf`. |
+//! <!-- end of parameters -->
+//!
 //! Zero roughness is the mirror, exactly. Anisotropic roughness is along the frame's
 //! `u` and `v` (rotate the frame first with cov-projection's `RotateFrame`).
 //!
@@ -41,7 +53,7 @@
 //!
 //! let mut c = Cov::<2>::gaussian([0.01, 0.05])?;
 //! let r = Reflect::new(0.8, 0.8, Curvature::isotropic(2.0)?, Lobe::phong(100.0)?)?;
-//! Operator::<2>::apply(&r, &mut c)?;
+//! Operator::apply(&r, &mut c)?;
 //! assert!(c.validity().is_valid());
 //! # Ok::<(), cov_core::CovError>(())
 //! ```
@@ -70,7 +82,7 @@
 
 pub mod spec;
 
-use cov_core::{Cov, CovError, FOUR_PI_SQ, Operator, Spectrum};
+use cov_core::{CovError, FOUR_PI_SQ, Operator, Spectrum};
 use cov_curvature::Curvature;
 use cov_projection::{Mirror, Project, Unproject};
 
@@ -118,7 +130,7 @@ impl Lobe {
     /// # Errors
     /// Negative or non-finite exponent.
     pub fn phong(exponent: f64) -> Result<Lobe, CovError> {
-        CovError::check_non_negative("Phong", "exponent", exponent)?;
+        CovError::require_non_negative("Phong", "exponent", exponent)?;
         Ok(Lobe::Phong { exponent })
     }
 
@@ -161,7 +173,7 @@ impl Lobe {
             Lobe::Ggx { alpha_u, alpha_v } => [("Ggx", "alpha_u", alpha_u), ("Ggx", "alpha_v", alpha_v)],
         };
         for (op, name, v) in params {
-            CovError::check_non_negative(op, name, v)?;
+            CovError::require_non_negative(op, name, v)?;
         }
         Ok(self)
     }
@@ -191,9 +203,9 @@ impl Lobe {
     ///
     /// # Errors
     /// Overflow.
-    pub fn apply_to<const N: usize>(&self, cov: &mut dyn Spectrum<N>) -> Result<(), CovError> {
+    pub fn apply_to(&self, cov: &mut dyn Spectrum) -> Result<(), CovError> {
         let (vu, vv) = self.variances();
-        let dirs = Cov::<N>::direction_axes();
+        let dirs = cov.direction_axes();
         for (&axis, var) in dirs.iter().zip([vu, vv]) {
             if var == 0.0 {
                 continue;
@@ -231,12 +243,9 @@ impl Brdf {
     }
 }
 
-impl<const N: usize> Operator<N> for Brdf {
-    fn apply(&self, cov: &mut dyn Spectrum<N>) -> Result<(), CovError> {
+impl Operator for Brdf {
+    fn apply(&self, cov: &mut dyn Spectrum) -> Result<(), CovError> {
         self.lobe.apply_to(cov)
-    }
-    fn name(&self) -> &str {
-        Self::NAME
     }
 }
 
@@ -266,21 +275,18 @@ impl Reflect {
     }
 }
 
-impl<const N: usize> Operator<N> for Reflect {
-    fn apply(&self, cov: &mut dyn Spectrum<N>) -> Result<(), CovError> {
-        Operator::<N>::apply(&self.project, cov)?;
+impl Operator for Reflect {
+    fn apply(&self, cov: &mut dyn Spectrum) -> Result<(), CovError> {
+        Operator::apply(&self.project, cov)?;
         // Incident directions in the surface frame point back toward the light.
-        Operator::<N>::apply(&Mirror, cov)?;
+        Operator::apply(&Mirror, cov)?;
         self.curvature.apply_oblique(cov, self.project.cos(), 1.0)?;
-        Operator::<N>::apply(&Mirror, cov)?;
+        Operator::apply(&Mirror, cov)?;
         self.lobe.apply_to(cov)?;
         self.curvature.apply_oblique(cov, self.unproject.cos(), -1.0)?;
-        Operator::<N>::apply(&self.unproject, cov)
-    }
-    fn name(&self) -> &str {
-        Self::NAME
+        Operator::apply(&self.unproject, cov)
     }
     fn requires(&self) -> cov_core::AxisSet {
-        Operator::<5>::requires(&self.curvature)
+        Operator::requires(&self.curvature)
     }
 }

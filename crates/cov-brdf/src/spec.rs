@@ -1,88 +1,54 @@
 //! RON parameters of the BRDF operators.
 
 use cov_core::CovError;
+use cov_core::{OperatorSpec, Registrar};
 use cov_curvature::spec::CurvatureSpec;
-use cov_path::{OperatorSpec, Param, Registry};
-use serde::Deserialize;
 
 use crate::{Brdf, Lobe, Reflect};
 
 /// `Brdf(lobe: Phong(exponent: 100))`.
-#[derive(Debug, Deserialize)]
-#[serde(deny_unknown_fields)]
+#[derive(Debug, OperatorSpec)]
+#[operator(summary = "an angular lobe (BRDF, BTDF) convolving directions")]
 pub struct BrdfSpec {
-    /// The lobe: `Diffuse`, `Mirror`, `Phong(exponent:)`, `Gaussian(var_u:, var_v:)`,
-    /// `Beckmann(alpha_u:, alpha_v:)`, `Ggx(alpha_u:, alpha_v:)`.
+    /// The lobe: `Diffuse`, `Mirror`, `Phong(exponent)`, `Gaussian(var_u, var_v)`, `Beckmann(alpha_u, alpha_v)` or `Ggx(alpha_u, alpha_v)`.
     pub lobe: Lobe,
 }
 
-impl OperatorSpec for BrdfSpec {
-    const NAME: &'static str = Brdf::NAME;
-    const SUMMARY: &'static str = "an angular lobe (BRDF, BTDF) convolving directions";
-    const PARAMS: &'static [Param] = &[Param {
-        name: "lobe",
-        unit: "",
-        doc: "Diffuse | Mirror | Phong(exponent) | Gaussian(var_u, var_v) | Beckmann(alpha_u, alpha_v) | Ggx(alpha_u, alpha_v)",
-    }];
-    type Op = Brdf;
-    fn build(self) -> Result<Brdf, CovError> {
-        Brdf::new(self.lobe)
+impl TryFrom<BrdfSpec> for Brdf {
+    type Error = CovError;
+    fn try_from(spec: BrdfSpec) -> Result<Brdf, CovError> {
+        Brdf::new(spec.lobe)
     }
 }
 
 /// `Reflect(cos_in: 0.8, cos_out: 0.8, curvature: (k: 2.0), lobe: Phong(exponent: 200))`.
-#[derive(Debug, Deserialize)]
-#[serde(deny_unknown_fields)]
+#[derive(Debug, OperatorSpec)]
+#[operator(summary = "reflection at a curved surface (projection, curvature, symmetry, lobe, back)")]
 pub struct ReflectSpec {
-    /// `|cos θ_in|`.
+    /// `|cos θ_in|`, in (0, 1].
     pub cos_in: f64,
-    /// `|cos θ_out|`.
+    /// `|cos θ_out|`, in (0, 1].
     pub cos_out: f64,
-    /// Surface curvature (default flat).
-    #[serde(default)]
+    /// Surface curvature, `(k: …)` or `(kx: …, ky: …, angle: …)`; flat when left out.
+    #[param(unit = "1/m", default)]
     pub curvature: CurvatureSpec,
-    /// The lobe.
+    /// The lobe, as in `Brdf`.
     pub lobe: Lobe,
 }
 
-impl OperatorSpec for ReflectSpec {
-    const NAME: &'static str = Reflect::NAME;
-    const SUMMARY: &'static str =
-        "reflection at a curved surface (projection, curvature, symmetry, lobe, back)";
-    const PARAMS: &'static [Param] = &[
-        Param {
-            name: "cos_in",
-            unit: "–",
-            doc: "(0, 1]",
-        },
-        Param {
-            name: "cos_out",
-            unit: "–",
-            doc: "(0, 1]",
-        },
-        Param {
-            name: "curvature",
-            unit: "1/m",
-            doc: "(k: …) or (kx: …, ky: …, angle: …), default flat",
-        },
-        Param {
-            name: "lobe",
-            unit: "",
-            doc: "as in Brdf",
-        },
-    ];
-    type Op = Reflect;
-    fn build(self) -> Result<Reflect, CovError> {
+impl TryFrom<ReflectSpec> for Reflect {
+    type Error = CovError;
+    fn try_from(spec: ReflectSpec) -> Result<Reflect, CovError> {
         Reflect::new(
-            self.cos_in,
-            self.cos_out,
-            self.curvature.to_curvature()?,
-            self.lobe,
+            spec.cos_in,
+            spec.cos_out,
+            spec.curvature.to_curvature()?,
+            spec.lobe,
         )
     }
 }
 
 /// Registers this crate's operators.
-pub fn register(r: &mut Registry) {
-    r.register::<BrdfSpec>().register::<ReflectSpec>();
+pub fn register<R: Registrar>(r: &mut R) {
+    r.add::<BrdfSpec>().add::<ReflectSpec>();
 }

@@ -111,7 +111,7 @@ fn check(q: &Quadric, theta: f64, curvature: Curvature) {
     let expected = a.transpose() * DMatrix::from_fn(4, 4, |i, k| m[(i, k)]) * &a;
     let mut got = start;
     let cos = theta.cos();
-    Operator::<4>::apply(
+    Operator::apply(
         &Reflect::new(cos, cos, curvature, Lobe::Mirror).unwrap(),
         &mut got,
     )

@@ -49,7 +49,7 @@ pub fn format_evaluation(name: &str, e: &Evaluation) -> String {
         }
         out.push('\n');
     };
-    row("-", "source", &bw(&e.start));
+    row("-", "source", &bw(&e.start.rows()));
     for (i, s) in e.steps.iter().enumerate() {
         row(&i.to_string(), &s.operator, &s.bandwidths);
     }
@@ -58,7 +58,7 @@ pub fn format_evaluation(name: &str, e: &Evaluation) -> String {
         out.push_str(&format!(" {a:>12}"));
     }
     out.push('\n');
-    for (i, r) in e.result.iter().enumerate() {
+    for (i, r) in e.result.rows().iter().enumerate() {
         out.push_str(&format!("  {:>2} ", e.axes[i]));
         for v in r {
             out.push_str(&format!(" {v:>12.4e}"));

@@ -97,28 +97,6 @@ fn main() -> ExitCode {
     }
 }
 
-/// The per-pixel decisions when the path ends at a `Sensor` (from Σ just before it).
-fn sensor_decisions(
-    p: &Path,
-    e: &covtrace::path::Evaluation,
-) -> Result<Option<covtrace::sensor::PixelDecisions>, String> {
-    let Some(last) = p.operators.last() else {
-        return Ok(None);
-    };
-    let Some(sensor) = last.0.as_any().downcast_ref::<covtrace::sensor::Sensor>() else {
-        return Ok(None);
-    };
-    let before = if e.steps.len() >= 2 {
-        &e.steps[e.steps.len() - 2].matrix
-    } else {
-        &e.start
-    };
-    sensor
-        .decisions_rows(before)
-        .map(Some)
-        .map_err(|err| err.to_string())
-}
-
 fn json_with_decisions(
     e: &covtrace::path::Evaluation,
     d: Option<&covtrace::sensor::PixelDecisions>,
@@ -141,8 +119,9 @@ fn run(cli: Cli) -> Result<(), String> {
         Command::Eval { path, json, form } => {
             let p = Path::load(&path, &registry).map_err(|e| e.to_string())?;
             let name = path.display().to_string();
-            let e = p.eval_in(form.into()).map_err(|e| e.in_file(&name).to_string())?;
-            let decisions = sensor_decisions(&p, &e).map_err(|m| format!("{name}: {m}"))?;
+            let e = p.eval_in(form.into()).map_err(|e| e.to_string())?;
+            // A sensor reports its per-pixel decisions as a typed value of the evaluation.
+            let decisions = e.report::<covtrace::sensor::PixelDecisions>().cloned();
             if json {
                 say!("{}", json_with_decisions(&e, decisions.as_ref()));
             } else {
@@ -154,8 +133,7 @@ fn run(cli: Cli) -> Result<(), String> {
         }
         Command::Plot { path, output } => {
             let p = Path::load(&path, &registry).map_err(|e| e.to_string())?;
-            let name = path.display().to_string();
-            let e = p.eval().map_err(|e| e.in_file(&name).to_string())?;
+            let e = p.eval().map_err(|e| e.to_string())?;
             let legend = plot::plot(&e, &output).map_err(|e| format!("{}: {e}", output.display()))?;
             say!("{}", legend.trim_end());
             say!("written to {}", output.display());
@@ -198,11 +176,13 @@ fn run(cli: Cli) -> Result<(), String> {
         Command::List => {
             for e in registry.entries() {
                 say!("{}: {}", e.name, e.summary);
-                if e.unit {
-                    say!("    (no parameters: write `{}`)", e.name);
+                if e.params.is_empty() {
+                    say!("    (no parameters: write `{0}` or `{0}()`)", e.name);
                 }
                 for p in e.params {
-                    say!("    {:<10} {:<13} {}", p.name, p.unit, p.doc);
+                    let default = p.default.map(|d| format!(" (default {d})")).unwrap_or_default();
+                    let unit = if p.unit.is_empty() { "–" } else { p.unit };
+                    say!("    {:<10} {:<13} {}{default}", p.name, unit, p.doc);
                 }
             }
         }

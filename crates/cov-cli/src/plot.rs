@@ -34,9 +34,9 @@ fn planes(n: usize) -> Vec<((usize, usize), Rgb<u8>, &'static str)> {
 /// # Errors
 /// The image cannot be written.
 pub fn plot(e: &Evaluation, out: &std::path::Path) -> Result<String, image::ImageError> {
-    let mut mats: Vec<(&str, &Vec<Vec<f64>>)> = vec![("source", &e.start)];
+    let mut mats: Vec<(&str, Vec<Vec<f64>>)> = vec![("source", e.start.rows())];
     for s in &e.steps {
-        mats.push((&s.operator, &s.matrix));
+        mats.push((&s.operator, s.matrix.rows()));
     }
     let count = mats.len() as u32;
     let cols = count.min(PER_ROW);

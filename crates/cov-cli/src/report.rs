@@ -22,7 +22,7 @@ pub struct Case {
     /// Whether the chain is Gaussian (exact closed form) or an approximation.
     pub gaussian: bool,
     /// The operators.
-    pub chain: Chain<2>,
+    pub chain: Chain,
     /// The same chain as a primal light field.
     pub field: Field,
 }

@@ -121,7 +121,7 @@ impl<const N: usize> Cov<N> {
         let mut c = Self::zeros();
         for (i, v) in variances.iter().enumerate() {
             let name = Self::axes()[i].name();
-            CovError::check_non_negative("Cov::from_diagonal", name, *v)?;
+            CovError::require_non_negative("Cov::from_diagonal", name, *v)?;
             c.set(i, i, *v);
         }
         Ok(c)
@@ -210,8 +210,8 @@ impl<const N: usize> Cov<N> {
     /// # Errors
     /// Non-finite or non-positive `scene_scale` (m) or `relative_size`.
     pub fn dirac(scene_scale: f64, relative_size: f64) -> Result<Self, CovError> {
-        CovError::check_positive("Cov::dirac", "scene_scale", scene_scale)?;
-        CovError::check_positive("Cov::dirac", "relative_size", relative_size)?;
+        CovError::require_positive("Cov::dirac", "scene_scale", scene_scale)?;
+        CovError::require_positive("Cov::dirac", "relative_size", relative_size)?;
         let s = scene_scale * relative_size;
         let v = 1.0 / (FOUR_PI_SQ * s * s);
         let mut c = Self::zeros();

@@ -109,7 +109,7 @@ impl CovError {
     /// # Errors
     /// [`CovError::NonFinite`] if `value` is NaN or infinite.
     #[inline]
-    pub fn check_finite(operator: &str, parameter: &str, value: f64) -> Result<f64, CovError> {
+    pub fn require_finite(operator: &str, parameter: &str, value: f64) -> Result<f64, CovError> {
         if value.is_finite() {
             Ok(value)
         } else {
@@ -132,14 +132,14 @@ impl CovError {
     /// # Errors
     /// [`CovError::NonFinite`] or [`CovError::OutOfRange`].
     #[inline]
-    pub fn check_range(
+    pub fn require_range(
         operator: &str,
         parameter: &str,
         value: f64,
         ok: impl FnOnce(f64) -> bool,
         expected: &str,
     ) -> Result<f64, CovError> {
-        Self::check_finite(operator, parameter, value)?;
+        Self::require_finite(operator, parameter, value)?;
         if ok(value) {
             Ok(value)
         } else {
@@ -162,8 +162,8 @@ impl CovError {
     /// # Errors
     /// [`CovError::NonFinite`] or [`CovError::OutOfRange`].
     #[inline]
-    pub fn check_positive(operator: &str, parameter: &str, value: f64) -> Result<f64, CovError> {
-        Self::check_range(operator, parameter, value, |v| v > 0.0, "must be > 0")
+    pub fn require_positive(operator: &str, parameter: &str, value: f64) -> Result<f64, CovError> {
+        Self::require_range(operator, parameter, value, |v| v > 0.0, "must be > 0")
     }
 
     /// Checks that `value` is finite and non-negative.
@@ -171,7 +171,7 @@ impl CovError {
     /// # Errors
     /// [`CovError::NonFinite`] or [`CovError::OutOfRange`].
     #[inline]
-    pub fn check_non_negative(operator: &str, parameter: &str, value: f64) -> Result<f64, CovError> {
-        Self::check_range(operator, parameter, value, |v| v >= 0.0, "must be >= 0")
+    pub fn require_non_negative(operator: &str, parameter: &str, value: f64) -> Result<f64, CovError> {
+        Self::require_range(operator, parameter, value, |v| v >= 0.0, "must be >= 0")
     }
 }

@@ -46,7 +46,7 @@
 //! decisions ([`SCHUR_SNAP`] on Σ, [`ROW_SNAP`] `= √SCHUR_SNAP` on the factor's rows).
 //!
 //! ```
-//! use cov_core::{Axis, Cov, CovError};
+//! use cov_core::{Axis, Cov, CovError, Spectrum};
 //!
 //! // A Gaussian spot of 1 mm std emitting into a cone of std 0.05 (tangent).
 //! let mut c = Cov::<2>::gaussian([1e-3, 0.05])?;
@@ -59,21 +59,30 @@
 
 #![warn(missing_docs)]
 
+mod any;
 mod axis;
 mod cov;
 mod error;
-mod factor;
-pub mod kernels;
+mod form;
 pub mod linalg;
 mod operator;
 mod query;
+mod report;
+pub mod spec;
 mod spectrum;
 
+pub use any::{AnyCov, AnyFactor, AnySpectrum};
 pub use axis::{Axis, AxisSet, axis_index, layout_axes, layout_set};
 pub use cov::{Cov, DIRAC_RELATIVE_SIZE, FOUR_PI_SQ, PSD_RTOL, Validity};
+pub use cov_derive::OperatorSpec;
 pub use error::CovError;
-pub use factor::{CovFactor, ROW_SNAP};
-pub use kernels::SCHUR_SNAP;
+pub use form::{CovFactor, ROW_SNAP, SCHUR_SNAP};
 pub use operator::{Chain, Operator, Step, Trace, check_layout};
 pub use query::{CovBlock, Filter, NYQUIST_K, primal_std_of_spectrum};
-pub use spectrum::{Form, Snapshot, Spectrum, SpectrumMut};
+pub use report::{Field, Report, ReportField};
+pub use spec::{OperatorReader, OperatorSpec, Param, Registrar};
+pub use spectrum::{Form, Spectrum, transverse_pairs};
+
+/// serde, for the code `#[derive(OperatorSpec)]` generates.
+#[doc(hidden)]
+pub use serde as __serde;

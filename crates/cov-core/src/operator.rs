@@ -1,19 +1,19 @@
 //! The [`Operator`] trait and [`Chain`]s of operators (light paths).
 
 use std::fmt;
+use std::sync::Arc;
 
-use crate::axis::layout_set;
-use crate::{AxisSet, Cov, CovError, CovFactor, Form, Spectrum};
+use crate::{AnyCov, AnySpectrum, AxisSet, Cov, CovError, Form, Report, Spectrum, layout_set};
 
-/// An event on a light path, acting on the spectrum covariance of layout `N`.
+/// An event on a light path, acting on the spectrum covariance.
 ///
-/// One required method, [`Operator::apply`]; the name defaults to the type's name and the
-/// required axes to flatland (`x, u`). `apply` acts through the [`Spectrum`] interface (the
-/// kernels of the four rules), so the same code runs on Σ in covariance or square-root
-/// form ([`Form`]); a `&mut dyn Spectrum<N>` is a `&mut dyn Spectrum<N>`. The trait is object safe: chains hold
-/// `Box<dyn Operator<N>>`. An operator that can act in several layouts implements the
-/// trait for each `N` (usually with one generic impl), and reports
-/// [`CovError::MissingAxis`] when asked to act in a layout without the axes it needs.
+/// One required method, [`Operator::apply`]. It acts through `&mut dyn Spectrum`, which
+/// knows its layout at run time ([`Spectrum::dim`], [`Spectrum::has`],
+/// [`Spectrum::transverse_pairs`]) and its form, so the same body serves every layout and
+/// both forms ([`Form`]); an operator asked to act in a layout without the axes it needs
+/// reports [`CovError::MissingAxis`] (the kernels do). The name defaults to the type's
+/// name and the required axes to flatland (`x, u`). The trait is object safe: chains hold
+/// `Arc<dyn Operator>`.
 ///
 /// ```
 /// use cov_core::{Axis, Cov, CovError, CovFactor, Operator, Spectrum};
@@ -22,34 +22,36 @@ use crate::{AxisSet, Cov, CovError, CovFactor, Form, Spectrum};
 /// #[derive(Debug)]
 /// struct MyTravel(f64);
 ///
-/// impl<const N: usize> Operator<N> for MyTravel {
-///     fn apply(&self, cov: &mut dyn Spectrum<N>) -> Result<(), CovError> {
-///         cov.shear(Axis::X, Axis::U, -self.0)?;
-///         if Cov::<N>::has(Axis::Y) {
-///             cov.shear(Axis::Y, Axis::V, -self.0)?;
+/// impl Operator for MyTravel {
+///     fn apply(&self, cov: &mut dyn Spectrum) -> Result<(), CovError> {
+///         for &(p, d) in cov.transverse_pairs() {
+///             cov.shear(p, d, -self.0)?;
 ///         }
 ///         Ok(())
 ///     }
 /// }
 ///
 /// let mut c = Cov::<2>::gaussian([0.1, f64::INFINITY])?;
-/// Operator::<2>::apply(&MyTravel(2.0), &mut c)?;
+/// MyTravel(2.0).apply(&mut c)?;
 /// assert!(c.get(1, 1) > 0.0); // travel moved spatial content into angle
-/// assert_eq!(Operator::<2>::name(&MyTravel(2.0)), "MyTravel");
+/// assert_eq!(MyTravel(2.0).name(), "MyTravel");
 ///
-/// // The same code acts on the square-root form.
+/// // The same code acts on the square-root form, and in 3D.
 /// let mut f = CovFactor::from_cov(&Cov::<2>::gaussian([0.1, f64::INFINITY])?);
-/// Operator::<2>::apply(&MyTravel(2.0), &mut f)?;
+/// MyTravel(2.0).apply(&mut f)?;
 /// approx::assert_relative_eq!(f.to_cov()?, c, max_relative = 1e-14);
+/// let mut c4 = Cov::<4>::gaussian([0.1, 0.1, f64::INFINITY, f64::INFINITY])?;
+/// MyTravel(2.0).apply(&mut c4)?;
+/// assert!(c4.get(3, 3) > 0.0);
 /// # Ok::<(), CovError>(())
 /// ```
-pub trait Operator<const N: usize>: fmt::Debug + Send + Sync {
+pub trait Operator: fmt::Debug + Send + Sync {
     /// Applies the operator to Σ in place.
     ///
     /// # Errors
     /// Whatever the operator finds wrong (missing axis, no transport, overflow). On error
     /// Σ may be partly updated; [`Chain`] restores it.
-    fn apply(&self, cov: &mut dyn Spectrum<N>) -> Result<(), CovError>;
+    fn apply(&self, cov: &mut dyn Spectrum) -> Result<(), CovError>;
 
     /// A short name for tables and error messages (default: the type's name without its
     /// module path).
@@ -62,6 +64,23 @@ pub trait Operator<const N: usize>: fmt::Debug + Send + Sync {
     fn requires(&self) -> AxisSet {
         AxisSet::FLAT
     }
+
+    /// What this operator reports when a chain is traced, given Σ just before it (a
+    /// sensor's per-pixel decisions). Default: nothing. Reports land in
+    /// [`Step::report`], typed ([`Report::get`]).
+    ///
+    /// # Errors
+    /// A report that cannot be computed (an overflowing decision, say).
+    fn report(&self, before: &AnyCov) -> Result<Option<Report>, CovError> {
+        let _ = before;
+        Ok(None)
+    }
+
+    /// Whether this operator ends a path: nothing may follow it, and it may stand only
+    /// once, at the top level (a sensor). Default: no.
+    fn is_terminal(&self) -> bool {
+        false
+    }
 }
 
 fn short_type_name(full: &'static str) -> &'static str {
@@ -69,72 +88,83 @@ fn short_type_name(full: &'static str) -> &'static str {
     base.rsplit("::").next().unwrap_or(base)
 }
 
-/// A light path: operators applied in order.
+/// A light path: operators applied in order. It has no layout of its own: it evaluates Σ
+/// of any layout its operators fit.
 ///
 /// ```
 /// use cov_core::{Axis, Chain, Cov, CovError, Form, Operator, Spectrum};
 /// # #[derive(Debug)] struct Travel(f64);
-/// # impl<const N: usize> Operator<N> for Travel {
-/// #     fn apply(&self, c: &mut dyn Spectrum<N>) -> Result<(), CovError> { c.shear(Axis::X, Axis::U, -self.0) }
+/// # impl Operator for Travel {
+/// #     fn apply(&self, c: &mut dyn Spectrum) -> Result<(), CovError> { c.shear(Axis::X, Axis::U, -self.0) }
 /// # }
-/// let chain = Chain::<2>::new().with(Travel(1.0)).with(Travel(2.0));
+/// let chain = Chain::new().with(Travel(1.0)).with(Travel(2.0));
 /// let start = Cov::<2>::gaussian([0.1, 1.0])?;
 /// let trace = chain.trace(start)?;
 /// assert_eq!(trace.steps.len(), 2);
-/// assert_eq!(trace.last(), chain.eval(start)?);
+/// assert_eq!(trace.last().to::<2>(), Some(chain.eval(start)?));
 /// // The covariance form gives the same Σ to rounding.
 /// let c = chain.eval_in(Form::Covariance, start)?;
 /// approx::assert_relative_eq!(c, chain.eval(start)?, max_relative = 1e-12);
 /// # Ok::<(), CovError>(())
 /// ```
-#[derive(Debug, Default)]
-pub struct Chain<const N: usize> {
-    steps: Vec<Box<dyn Operator<N>>>,
+#[derive(Clone, Debug, Default)]
+pub struct Chain {
+    steps: Vec<Arc<dyn Operator>>,
 }
 
 /// One recorded step of a [`Chain::trace`].
 #[derive(Clone, Debug, PartialEq)]
-pub struct Step<const N: usize> {
+pub struct Step {
     /// Name of the operator.
     pub name: String,
     /// Σ after the operator.
-    pub cov: Cov<N>,
+    pub cov: AnyCov,
+    /// What the operator reported ([`Operator::report`]), if anything.
+    pub report: Option<Report>,
 }
 
 /// Σ before and after every step of a chain.
 #[derive(Clone, Debug, PartialEq)]
-pub struct Trace<const N: usize> {
+pub struct Trace {
     /// Σ before the first step.
-    pub start: Cov<N>,
+    pub start: AnyCov,
     /// One entry per step.
-    pub steps: Vec<Step<N>>,
+    pub steps: Vec<Step>,
 }
 
-impl<const N: usize> Trace<N> {
+impl Trace {
     /// Σ after the last step (the start if the chain is empty).
-    pub fn last(&self) -> Cov<N> {
+    pub fn last(&self) -> AnyCov {
         self.steps.last().map(|s| s.cov).unwrap_or(self.start)
+    }
+
+    /// The reports of the trace, with the index of their step.
+    pub fn reports(&self) -> impl Iterator<Item = (usize, &Report)> {
+        self.steps
+            .iter()
+            .enumerate()
+            .filter_map(|(i, s)| s.report.as_ref().map(|r| (i, r)))
     }
 }
 
-impl<const N: usize> Chain<N> {
+impl Chain {
     /// An empty chain (the identity).
     pub fn new() -> Self {
         Chain { steps: Vec::new() }
     }
 
     /// Appends an operator.
-    pub fn push(&mut self, op: impl Operator<N> + 'static) {
-        self.steps.push(Box::new(op));
+    pub fn push(&mut self, op: impl Operator + 'static) {
+        self.steps.push(Arc::new(op));
     }
 
-    /// Appends a boxed operator.
-    pub fn push_boxed(&mut self, op: Box<dyn Operator<N>>) {
+    /// Appends a shared operator.
+    pub fn push_shared(&mut self, op: Arc<dyn Operator>) {
         self.steps.push(op);
     }
 
     /// Builder form of [`Chain::push`].
-    pub fn with(mut self, op: impl Operator<N> + 'static) -> Self {
+    pub fn with(mut self, op: impl Operator + 'static) -> Self {
         self.push(op);
         self
     }
@@ -150,8 +180,22 @@ impl<const N: usize> Chain<N> {
     }
 
     /// The operators, in order.
-    pub fn operators(&self) -> impl Iterator<Item = &dyn Operator<N>> {
+    pub fn operators(&self) -> impl Iterator<Item = &dyn Operator> {
         self.steps.iter().map(|b| b.as_ref())
+    }
+
+    /// The operators as shared handles, in order.
+    pub fn shared(&self) -> &[Arc<dyn Operator>] {
+        &self.steps
+    }
+
+    /// Names joined with `+` (for an enclosing operator's name).
+    pub fn names(&self) -> String {
+        self.steps
+            .iter()
+            .map(|op| op.name())
+            .collect::<Vec<_>>()
+            .join("+")
     }
 
     /// Applies every step to `start` in the default form ([`Form::SquareRoot`]) and
@@ -160,7 +204,7 @@ impl<const N: usize> Chain<N> {
     /// # Errors
     /// The first failing step, as [`CovError::Step`] with its index and name; also a
     /// step that returns a non-finite Σ (caught here even if the operator did not check).
-    pub fn eval(&self, start: Cov<N>) -> Result<Cov<N>, CovError> {
+    pub fn eval<const N: usize>(&self, start: Cov<N>) -> Result<Cov<N>, CovError> {
         self.eval_in(Form::default(), start)
     }
 
@@ -169,7 +213,7 @@ impl<const N: usize> Chain<N> {
     /// # Errors
     /// As [`Chain::eval`]; in square-root form also an overflow of the final Σ (the
     /// factor can carry √Σ beyond the range where Σ itself fits in f64).
-    pub fn eval_in(&self, form: Form, start: Cov<N>) -> Result<Cov<N>, CovError> {
+    pub fn eval_in<const N: usize>(&self, form: Form, start: Cov<N>) -> Result<Cov<N>, CovError> {
         match form {
             Form::Covariance => {
                 let mut c = start;
@@ -177,49 +221,66 @@ impl<const N: usize> Chain<N> {
                 Ok(c)
             }
             Form::SquareRoot => {
-                let mut f = CovFactor::from_cov(&start);
+                let mut f = crate::CovFactor::from_cov(&start);
                 self.apply(&mut f)?;
                 f.to_cov()
             }
         }
     }
 
-    /// Like [`Chain::eval`], recording Σ after every step.
-    ///
-    /// # Errors
-    /// As [`Chain::eval`].
-    pub fn trace(&self, start: Cov<N>) -> Result<Trace<N>, CovError> {
-        self.trace_in(Form::default(), start)
-    }
-
-    /// Like [`Chain::eval_in`], recording Σ after every step.
+    /// [`Chain::eval_in`] for a Σ whose layout is known at run time.
     ///
     /// # Errors
     /// As [`Chain::eval_in`].
-    pub fn trace_in(&self, form: Form, start: Cov<N>) -> Result<Trace<N>, CovError> {
-        let mut cov = start;
-        let mut factor: CovFactor<N>;
-        let s: &mut dyn Spectrum<N> = match form {
-            Form::Covariance => &mut cov,
-            Form::SquareRoot => {
-                factor = CovFactor::from_cov(&start);
-                &mut factor
-            }
-        };
+    pub fn eval_any(&self, form: Form, start: &AnyCov) -> Result<AnyCov, CovError> {
+        let mut held = AnySpectrum::new(form, start);
+        self.apply(held.as_spectrum_mut())?;
+        held.cov()
+    }
+
+    /// Like [`Chain::eval`], recording Σ (and any report) after every step.
+    ///
+    /// # Errors
+    /// As [`Chain::eval`].
+    pub fn trace(&self, start: impl Into<AnyCov>) -> Result<Trace, CovError> {
+        self.trace_in(Form::default(), start)
+    }
+
+    /// Like [`Chain::eval_in`], recording Σ (and any report) after every step.
+    ///
+    /// # Errors
+    /// As [`Chain::eval_in`], and a failing report (as [`CovError::Step`]).
+    pub fn trace_in(&self, form: Form, start: impl Into<AnyCov>) -> Result<Trace, CovError> {
+        let start = start.into();
+        let mut held = AnySpectrum::new(form, &start);
+        let s = held.as_spectrum_mut();
         let mut steps = Vec::with_capacity(self.steps.len());
+        let mut before = start;
         for (index, op) in self.steps.iter().enumerate() {
+            let report = op
+                .report(&before)
+                .map_err(|e| step_error(index, op.as_ref(), e))?;
             apply_step(index, op.as_ref(), s)?;
             let cov = s.cov().map_err(|e| step_error(index, op.as_ref(), e))?;
             steps.push(Step {
                 name: op.name().to_string(),
                 cov,
+                report,
             });
+            before = cov;
         }
         Ok(Trace { start, steps })
     }
+
+    /// The union of what the steps need.
+    pub fn requires_all(&self) -> AxisSet {
+        self.steps
+            .iter()
+            .fold(AxisSet::FLAT, |s, op| s.union(op.requires()))
+    }
 }
 
-fn step_error<const N: usize>(index: usize, op: &dyn Operator<N>, e: CovError) -> CovError {
+fn step_error(index: usize, op: &dyn Operator, e: CovError) -> CovError {
     CovError::Step {
         index,
         operator: op.name().to_string(),
@@ -227,13 +288,17 @@ fn step_error<const N: usize>(index: usize, op: &dyn Operator<N>, e: CovError) -
     }
 }
 
-fn apply_step<const N: usize>(
-    index: usize,
-    op: &dyn Operator<N>,
-    c: &mut dyn Spectrum<N>,
-) -> Result<(), CovError> {
+fn apply_step(index: usize, op: &dyn Operator, c: &mut dyn Spectrum) -> Result<(), CovError> {
     let before = c.snapshot();
-    let result = op.apply(c).and_then(|()| c.check_finite(op.name()));
+    let result = op.apply(c).and_then(|()| match c.first_non_finite() {
+        None => Ok(()),
+        Some((row, col, value)) => Err(CovError::Overflow {
+            operator: op.name().to_string(),
+            row,
+            col,
+            value,
+        }),
+    });
     if let Err(e) = result {
         c.restore(&before);
         return Err(step_error(index, op, e));
@@ -241,8 +306,8 @@ fn apply_step<const N: usize>(
     Ok(())
 }
 
-impl<const N: usize> Operator<N> for Chain<N> {
-    fn apply(&self, cov: &mut dyn Spectrum<N>) -> Result<(), CovError> {
+impl Operator for Chain {
+    fn apply(&self, cov: &mut dyn Spectrum) -> Result<(), CovError> {
         let start = cov.snapshot();
         for (index, op) in self.steps.iter().enumerate() {
             if let Err(e) = apply_step(index, op.as_ref(), cov) {
@@ -258,21 +323,19 @@ impl<const N: usize> Operator<N> for Chain<N> {
     }
 
     fn requires(&self) -> AxisSet {
-        self.steps
-            .iter()
-            .fold(AxisSet::FLAT, |s, op| s.union(op.requires()))
+        self.requires_all()
     }
 }
 
-/// Checks that the layout `N` has every axis `op` requires.
+/// Checks that layout `n` has every axis `op` requires.
 ///
 /// # Errors
 /// [`CovError::MissingAxis`] naming the first missing axis.
-pub fn check_layout<const N: usize>(op: &dyn Operator<N>) -> Result<(), CovError> {
-    let have = layout_set(N);
+pub fn check_layout(n: usize, op: &dyn Operator) -> Result<(), CovError> {
+    let have = layout_set(n);
     for axis in op.requires().iter() {
         if !have.contains(axis) {
-            return Err(CovError::MissingAxis { axis, layout: N });
+            return Err(CovError::MissingAxis { axis, layout: n });
         }
     }
     Ok(())

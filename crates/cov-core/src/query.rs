@@ -1,5 +1,6 @@
 //! Queries: what a renderer reads off Σ (PHYSICS.md section 4).
 
+use crate::Spectrum;
 use std::f64::consts::PI;
 use std::fmt;
 
@@ -190,7 +191,7 @@ impl CovBlock {
     /// # Errors
     /// Non-finite or non-positive `k`.
     pub fn sampling_density(&self, k: f64) -> Result<f64, CovError> {
-        CovError::check_positive("sampling_density", "k", k)?;
+        CovError::require_positive("sampling_density", "k", k)?;
         Ok((2.0 * k).powi(self.len() as i32) * self.spectrum_volume())
     }
 
@@ -215,7 +216,7 @@ impl CovBlock {
             });
         }
         for (a, e) in self.axes.iter().zip(max_extent) {
-            CovError::check_positive("reconstruction_filter", &format!("max_extent.{a}"), *e)?;
+            CovError::require_positive("reconstruction_filter", &format!("max_extent.{a}"), *e)?;
         }
         let mut st = [[0.0; MAX]; MAX];
         for i in 0..n {

@@ -1,241 +1,406 @@
-//! [`Spectrum`]: the four rules as an interface, so that one operator body acts on Σ in
-//! either form, the covariance [`Cov`] or the square-root [`CovFactor`].
+//! [`Spectrum`]: Σ in some form and layout, with the four rules as in-place operations.
+//!
+//! This is the one kernel surface of covtrace. The provided methods ([`Spectrum::shear`],
+//! [`Spectrum::convolve`], …) validate their parameters and resolve axis names against
+//! the layout once, then call the form's raw index kernels (`raw_*`), which the two forms
+//! implement: the covariance [`Cov`] (`form/cov.rs`) and the square-root [`CovFactor`]
+//! (`form/factor.rs`). An [`crate::Operator`] acts on `&mut dyn Spectrum` and reads the
+//! layout at run time ([`Spectrum::dim`], [`Spectrum::has`],
+//! [`Spectrum::transverse_pairs`]), so one operator body serves every layout and form.
 
-use std::any::Any;
 use std::fmt;
 
-use nalgebra::SMatrix;
-
-use crate::{Axis, Cov, CovError, CovFactor};
+use crate::axis::{axis_index, layout_axes};
+use crate::linalg::{MAX, Small, sym_eigen};
+use crate::{AnyCov, AnySpectrum, Axis, CovError, PSD_RTOL};
 
 /// How a chain holds Σ while it is evaluated.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize)]
 pub enum Form {
-    /// Σ itself ([`Cov`]): the cheapest kernels; a chain that moves Σ into a frame where
-    /// one block dwarfs another and back loses the small block's digits like
+    /// Σ itself ([`crate::Cov`]): the cheapest kernels; a chain that moves Σ into a frame
+    /// where one block dwarfs another and back loses the small block's digits like
     /// `ε · Σ_big/Σ_small` per event.
     Covariance,
-    /// `Σ = L Lᵀ` ([`CovFactor`]), updated by Potter's and the array algorithms: the same
-    /// loss is `ε · √(Σ_big/Σ_small)`, and Σ is PSD by construction. The default: on the
-    /// stiff suite's 10⁴-operator bounce chains it reaches 4e-13 to 2.4e-12 where the
-    /// covariance form reaches 4.1e-9 (README, "Numerical stability"), for 1.5× the
-    /// cost of a path.
+    /// `Σ = L Lᵀ` ([`crate::CovFactor`]), updated by Potter's and the array algorithms:
+    /// the same loss is `ε · √(Σ_big/Σ_small)`, and Σ is PSD by construction. The
+    /// default: on the stiff suite's 10⁴-operator bounce chains it reaches 4e-13 to
+    /// 2.4e-12 where the covariance form reaches 4.1e-9 (README, "Numerical stability").
     #[default]
     SquareRoot,
 }
 
-/// A saved Σ, in the form it was held in ([`Spectrum::snapshot`]).
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub enum Snapshot<const N: usize> {
-    /// Covariance form.
-    Covariance(Cov<N>),
-    /// Square-root form.
-    SquareRoot(CovFactor<N>),
-}
-
-/// A [`Spectrum`] seen with its layout known: what an operator whose layout is chosen at
-/// run time (a RON path) needs to call into a fixed-layout implementation.
-pub enum SpectrumMut<'a> {
-    /// `x, u`.
-    Two(&'a mut dyn Spectrum<2>),
-    /// `x, u, t`.
-    Three(&'a mut dyn Spectrum<3>),
-    /// `x, y, u, v`.
-    Four(&'a mut dyn Spectrum<4>),
-    /// `x, y, u, v, t`.
-    Five(&'a mut dyn Spectrum<5>),
-}
-
-/// Σ in some form, with the four rules as in-place operations. [`crate::Operator`]s act
-/// through this interface, so that a chain can run in the covariance or the square-root
-/// form ([`Form`]) with the same operator code. The kernels mean exactly what the
-/// [`Cov`] kernels of the same name mean (see `cov_core::kernels`).
+/// Σ in some form and layout: the four rules as in-place operations.
 ///
-/// An operator that needs something the kernels do not offer reads Σ with
-/// [`Spectrum::cov`] and writes it back with [`Spectrum::assign`] (the square-root form
-/// then refactors Σ, and its accuracy advantage is lost at that step only).
-pub trait Spectrum<const N: usize>: fmt::Debug {
+/// **Provided methods** (what operators call) take axis names and user-facing
+/// parameters, check them (finite, in range, axes in the layout and distinct) and then
+/// call the raw kernels once. **Required methods** are the form's state and its raw
+/// kernels, which take indices already resolved and parameters already checked; they
+/// report only what depends on the result (an overflow), and leave Σ unchanged when they
+/// do.
+///
+/// ```
+/// use cov_core::{Axis, Cov, CovError, CovFactor, Spectrum};
+///
+/// // The same calls on either form, through the trait object an operator sees.
+/// let start = Cov::<2>::gaussian([1e-3, 0.05])?;
+/// let mut c = start;
+/// let mut f = CovFactor::from_cov(&start);
+/// for s in [&mut c as &mut dyn Spectrum, &mut f] {
+///     s.shear(Axis::X, Axis::U, -0.5)?; // travel 0.5 m
+///     s.convolve(&[Axis::U], &[100.0])?; // a glossy lobe
+///     assert_eq!(s.dim(), 2);
+///     assert!(!s.has(Axis::Y));
+/// }
+/// approx::assert_relative_eq!(f.to_cov()?, c, max_relative = 1e-12);
+/// # Ok::<(), CovError>(())
+/// ```
+pub trait Spectrum: fmt::Debug {
+    // ---- state -----------------------------------------------------------------
+
+    /// The layout size N (2: x,u; 3: x,u,t; 4: x,y,u,v; 5: x,y,u,v,t).
+    fn dim(&self) -> usize;
     /// The form Σ is held in.
     fn form(&self) -> Form;
     /// Σ now.
     ///
     /// # Errors
     /// [`CovError::Overflow`] if Σ exceeds the f64 range (possible in square-root form).
-    fn cov(&self) -> Result<Cov<N>, CovError>;
-    /// Replaces Σ.
+    fn cov(&self) -> Result<AnyCov, CovError>;
+    /// Replaces Σ (converting to this form).
     ///
     /// # Errors
-    /// A non-finite entry.
-    fn assign(&mut self, c: &Cov<N>) -> Result<(), CovError>;
+    /// A non-finite entry, or a Σ of another layout ([`CovError::Shape`]).
+    fn assign(&mut self, c: &AnyCov) -> Result<(), CovError>;
     /// Saves Σ exactly as held.
-    fn snapshot(&self) -> Snapshot<N>;
-    /// Restores a [`Spectrum::snapshot`] (converting if it was taken in the other form).
-    fn restore(&mut self, s: &Snapshot<N>);
-    /// Checks every stored number is finite.
-    ///
-    /// # Errors
-    /// [`CovError::Overflow`] naming `operator`.
-    fn check_finite(&self, operator: &str) -> Result<(), CovError>;
-    /// This Σ with its layout known ([`SpectrumMut`]).
-    fn layout(&mut self) -> SpectrumMut<'_>;
+    fn snapshot(&self) -> AnySpectrum;
+    /// Restores a [`Spectrum::snapshot`] of the same layout (converting if it was taken
+    /// in the other form); a snapshot of another layout is ignored.
+    fn restore(&mut self, s: &AnySpectrum);
+    /// The first stored number that is not finite, as (row, column, value), if any.
+    fn first_non_finite(&self) -> Option<(usize, usize, f64)>;
 
-    /// Rule 1 with a dense matrix, `Σ' = Aᵀ Σ A` ([`Cov::congruence`]).
-    ///
-    /// # Errors
-    /// As [`Cov::congruence`].
-    fn congruence(&mut self, a: &SMatrix<f64, N, N>) -> Result<(), CovError>;
-    /// Rule 1, elementary shear ([`Cov::shear`]).
-    ///
-    /// # Errors
-    /// As [`Cov::shear`].
-    fn shear(&mut self, target: Axis, source: Axis, s: f64) -> Result<(), CovError>;
-    /// Rule 1, scaling ([`Cov::scale`]).
-    ///
-    /// # Errors
-    /// As [`Cov::scale`].
-    fn scale(&mut self, axis: Axis, c: f64) -> Result<(), CovError>;
-    /// Rule 1, rotation in the plane of two axes ([`Cov::rotate`]).
-    ///
-    /// # Errors
-    /// As [`Cov::rotate`].
-    fn rotate(&mut self, a: Axis, b: Axis, angle: f64) -> Result<(), CovError>;
-    /// Rotation of the 3D tangent frame ([`Cov::rotate_frame`]).
-    ///
-    /// # Errors
-    /// As [`Cov::rotate_frame`].
-    fn rotate_frame(&mut self, angle: f64) -> Result<(), CovError>;
-    /// Rule 2 on one axis ([`Cov::add_variance`]).
-    ///
-    /// # Errors
-    /// As [`Cov::add_variance`].
-    fn add_variance(&mut self, axis: Axis, w: f64) -> Result<(), CovError>;
-    /// Rule 2 ([`Cov::add_window`]).
-    ///
-    /// # Errors
-    /// As [`Cov::add_window`].
-    fn add_window(&mut self, axes: &[Axis], w: &[f64]) -> Result<(), CovError>;
-    /// Rule 3 ([`Cov::convolve`]).
-    ///
-    /// # Errors
-    /// As [`Cov::convolve`].
-    fn convolve(&mut self, axes: &[Axis], s: &[f64]) -> Result<(), CovError>;
-    /// Rule 4 ([`Cov::integrate`]).
-    ///
-    /// # Errors
-    /// As [`Cov::integrate`].
-    fn integrate(&mut self, axes: &[Axis]) -> Result<(), CovError>;
-}
+    // ---- raw kernels: indices resolved, parameters checked -----------------------
 
-/// The layout dispatch of [`Spectrum::layout`] for a concrete type family.
-///
-/// `Cov<N>` (and so `CovFactor<N>`) exists for N = 2..=5 only (a compile-time assertion
-/// in `Cov`), so exactly one of the four type tests succeeds and the `expect`s cannot
-/// fail: each runs right after the `is` test of the same type.
-macro_rules! layout_arms {
-    ($value:ident, $ty:ident) => {{
-        let any: &mut dyn Any = $value;
-        if any.is::<$ty<2>>() {
-            SpectrumMut::Two(any.downcast_mut::<$ty<2>>().expect("tested by `is`"))
-        } else if any.is::<$ty<3>>() {
-            SpectrumMut::Three(any.downcast_mut::<$ty<3>>().expect("tested by `is`"))
-        } else if any.is::<$ty<4>>() {
-            SpectrumMut::Four(any.downcast_mut::<$ty<4>>().expect("tested by `is`"))
+    /// Rule 1, `Σ' = Aᵀ Σ A`, with `a[l][j] = A_lj` (the first `dim` rows and columns).
+    ///
+    /// # Errors
+    /// [`CovError::Overflow`] naming `op`; Σ is left unchanged.
+    fn raw_congruence(&mut self, op: &str, a: &Small) -> Result<(), CovError>;
+    /// Rule 1, elementary shear `z'_i = z_i + s·z_j` (indices `i ≠ j`).
+    ///
+    /// # Errors
+    /// [`CovError::Overflow`] naming `op`; Σ is left unchanged.
+    fn raw_shear(&mut self, op: &str, i: usize, j: usize, s: f64) -> Result<(), CovError>;
+    /// Rule 1, scaling `z'_i = c·z_i`.
+    ///
+    /// # Errors
+    /// [`CovError::Overflow`] naming `op`; Σ is left unchanged.
+    fn raw_scale(&mut self, op: &str, i: usize, c: f64) -> Result<(), CovError>;
+    /// Rule 1, rotations by the same angle (`cos`, `sin`) in each plane of `planes`
+    /// (pairs of distinct indices, the pairs disjoint).
+    ///
+    /// # Errors
+    /// [`CovError::Overflow`] naming `op`; Σ is left unchanged.
+    fn raw_rotate(&mut self, op: &str, planes: &[(usize, usize)], cos: f64, sin: f64)
+    -> Result<(), CovError>;
+    /// Rule 2, `Σ_pp += W` for the distinct indices `p`, `W` symmetric PSD (`p.len()`
+    /// rows and columns of `w`).
+    ///
+    /// # Errors
+    /// [`CovError::Overflow`] naming `op`; Σ is left unchanged.
+    fn raw_add_window(&mut self, op: &str, p: &[usize], w: &Small) -> Result<(), CovError>;
+    /// Rule 3 along the distinct indices `p` with lobe spectrum `S` (symmetric PSD); rule
+    /// 4 is `S = 0`.
+    ///
+    /// # Errors
+    /// [`CovError::Overflow`] naming `op`; Σ is left unchanged.
+    fn raw_lobe(&mut self, op: &str, p: &[usize], s: &Small) -> Result<(), CovError>;
+
+    // ---- layout ---------------------------------------------------------------------
+
+    /// The axes of this layout, in order.
+    fn axes(&self) -> &'static [Axis] {
+        layout_axes(self.dim()).unwrap_or(&[])
+    }
+
+    /// Whether this layout has `axis`.
+    fn has(&self, axis: Axis) -> bool {
+        axis_index(self.dim(), axis).is_ok()
+    }
+
+    /// Index of `axis` in this layout.
+    ///
+    /// # Errors
+    /// [`CovError::MissingAxis`] if the layout has no such axis.
+    #[inline]
+    fn index(&self, axis: Axis) -> Result<usize, CovError> {
+        axis_index(self.dim(), axis)
+    }
+
+    /// The (position, direction) axis pairs of this layout: `[(x, u)]` in flatland,
+    /// `[(x, u), (y, v)]` in 3D. Flatland operator definitions apply to each pair.
+    fn transverse_pairs(&self) -> &'static [(Axis, Axis)] {
+        transverse_pairs(self.dim())
+    }
+
+    /// The direction axes of this layout: `[u]` or `[u, v]`.
+    fn direction_axes(&self) -> &'static [Axis] {
+        if self.dim() >= 4 {
+            &[Axis::U, Axis::V]
         } else {
-            SpectrumMut::Five(any.downcast_mut::<$ty<5>>().expect("N is 2..=5"))
+            &[Axis::U]
         }
-    }};
-}
+    }
 
-macro_rules! delegate_kernels {
-    () => {
-        fn congruence(&mut self, a: &SMatrix<f64, N, N>) -> Result<(), CovError> {
-            Self::congruence(self, a)
+    /// The spatial axes of this layout: `[x]` or `[x, y]`.
+    fn spatial_axes(&self) -> &'static [Axis] {
+        if self.dim() >= 4 {
+            &[Axis::X, Axis::Y]
+        } else {
+            &[Axis::X]
         }
-        fn shear(&mut self, target: Axis, source: Axis, s: f64) -> Result<(), CovError> {
-            Self::shear(self, target, source, s)
-        }
-        fn scale(&mut self, axis: Axis, c: f64) -> Result<(), CovError> {
-            Self::scale(self, axis, c)
-        }
-        fn rotate(&mut self, a: Axis, b: Axis, angle: f64) -> Result<(), CovError> {
-            Self::rotate(self, a, b, angle)
-        }
-        fn rotate_frame(&mut self, angle: f64) -> Result<(), CovError> {
-            Self::rotate_frame(self, angle)
-        }
-        fn add_variance(&mut self, axis: Axis, w: f64) -> Result<(), CovError> {
-            Self::add_variance(self, axis, w)
-        }
-        fn add_window(&mut self, axes: &[Axis], w: &[f64]) -> Result<(), CovError> {
-            Self::add_window(self, axes, w)
-        }
-        fn convolve(&mut self, axes: &[Axis], s: &[f64]) -> Result<(), CovError> {
-            Self::convolve(self, axes, s)
-        }
-        fn integrate(&mut self, axes: &[Axis]) -> Result<(), CovError> {
-            Self::integrate(self, axes)
-        }
-        fn check_finite(&self, operator: &str) -> Result<(), CovError> {
-            Self::check_finite(self, operator)
-        }
-    };
-}
+    }
 
-impl<const N: usize> Spectrum<N> for Cov<N> {
-    fn form(&self) -> Form {
-        Form::Covariance
-    }
-    fn cov(&self) -> Result<Cov<N>, CovError> {
-        Ok(*self)
-    }
-    fn assign(&mut self, c: &Cov<N>) -> Result<(), CovError> {
-        c.check_finite("assign")?;
-        *self = *c;
-        Ok(())
-    }
-    fn snapshot(&self) -> Snapshot<N> {
-        Snapshot::Covariance(*self)
-    }
-    fn restore(&mut self, s: &Snapshot<N>) {
-        match s {
-            Snapshot::Covariance(c) => *self = *c,
-            // A factor of a finite Σ: `to_cov` fails only on overflow, when Σ is left.
-            Snapshot::SquareRoot(f) => {
-                if let Ok(c) = f.to_cov() {
-                    *self = c;
-                }
+    // ---- the four rules, checked ----------------------------------------------------
+
+    /// Rule 1 with a dense matrix: `l'(z) = l(A z)` gives `Σ' = Aᵀ Σ A`; `a` holds `A`
+    /// row-major (`dim²` numbers).
+    ///
+    /// # Errors
+    /// Wrong size, a non-finite entry in `a`, or an overflowing result.
+    fn congruence(&mut self, a: &[f64]) -> Result<(), CovError> {
+        let n = self.dim();
+        if a.len() != n * n {
+            return Err(CovError::Shape {
+                what: "congruence: A".into(),
+                expected: format!("{} numbers ({n}×{n} row-major)", n * n),
+                got: format!("{} numbers", a.len()),
+            });
+        }
+        let mut m = [[0.0; MAX]; MAX];
+        for l in 0..n {
+            for j in 0..n {
+                m[l][j] = CovError::require_finite("congruence", "A", a[l * n + j])?;
             }
         }
+        self.raw_congruence("congruence", &m)
     }
-    fn layout(&mut self) -> SpectrumMut<'_> {
-        layout_arms!(self, Cov)
+
+    /// Rule 1, elementary shear: `l'(z) = l(z')` with `z'_target = z_target + s·z_source`.
+    ///
+    /// In the spectrum this adds `s ×` row/column `target` to row/column `source`.
+    /// Travel by `d` is `shear(X, U, −d)`; curvature `k` is `shear(U, X, k)`.
+    ///
+    /// # Errors
+    /// Missing axis, `target == source`, non-finite `s`, or an overflowing result.
+    #[inline]
+    fn shear(&mut self, target: Axis, source: Axis, s: f64) -> Result<(), CovError> {
+        CovError::require_finite("shear", "s", s)?;
+        let (i, j) = two_axes(self.dim(), "shear", target, source)?;
+        if s == 0.0 {
+            return Ok(());
+        }
+        self.raw_shear("shear", i, j, s)
     }
-    delegate_kernels!();
+
+    /// Rule 1, scaling: `l'(z) = l(z')` with `z'_axis = c·z_axis` (a projection by a
+    /// cosine is `scale(X, cos θ)`). Row and column `axis` of Σ are multiplied by `c`.
+    ///
+    /// # Errors
+    /// Missing axis, non-finite `c`, or an overflowing result.
+    #[inline]
+    fn scale(&mut self, axis: Axis, c: f64) -> Result<(), CovError> {
+        CovError::require_finite("scale", "c", c)?;
+        let i = self.index(axis)?;
+        self.raw_scale("scale", i, c)
+    }
+
+    /// Rule 1, rotation in the plane of two axes: `l'(z) = l(z')` with
+    /// `(z'_a, z'_b) = (cos α·z_a − sin α·z_b, sin α·z_a + cos α·z_b)`, α in radians.
+    ///
+    /// # Errors
+    /// Missing axis, `a == b`, non-finite `angle`.
+    #[inline]
+    fn rotate(&mut self, a: Axis, b: Axis, angle: f64) -> Result<(), CovError> {
+        CovError::require_finite("rotate", "angle", angle)?;
+        let (i, j) = two_axes(self.dim(), "rotate", a, b)?;
+        let (s, c) = angle.sin_cos();
+        self.raw_rotate("rotate", &[(i, j)], c, s)
+    }
+
+    /// Rotation of the 3D tangent frame by `angle` (radians): `(x, y)` and `(u, v)` turn
+    /// together, as [`Spectrum::rotate`] on both pairs.
+    ///
+    /// # Errors
+    /// [`CovError::MissingAxis`] in flatland (N = 2, 3); non-finite `angle`.
+    fn rotate_frame(&mut self, angle: f64) -> Result<(), CovError> {
+        CovError::require_finite("rotate_frame", "angle", angle)?;
+        let (x, y, u, v) = (
+            self.index(Axis::X)?,
+            self.index(Axis::Y)?,
+            self.index(Axis::U)?,
+            self.index(Axis::V)?,
+        );
+        let (s, c) = angle.sin_cos();
+        self.raw_rotate("rotate_frame", &[(x, y), (u, v)], c, s)
+    }
+
+    /// Rule 2 on one axis: multiplying the primal by a window adds its spectrum variance,
+    /// `Σ_aa += w` ((cycles/unit)²). A Gaussian window of std `s` has `w = 1/(4π²s²)`.
+    ///
+    /// # Errors
+    /// Missing axis, `w` negative or non-finite, overflow.
+    #[inline]
+    fn add_variance(&mut self, axis: Axis, w: f64) -> Result<(), CovError> {
+        CovError::require_non_negative("add_variance", "w", w)?;
+        let i = self.index(axis)?;
+        if w == 0.0 {
+            return Ok(());
+        }
+        let mut m = [[0.0; MAX]; MAX];
+        m[0][0] = w;
+        self.raw_add_window("add_variance", &[i], &m)
+    }
+
+    /// Rule 2: `Σ' = Σ + W`, with `W` the spectrum covariance of the window on `axes`,
+    /// given row-major as `axes.len()²` numbers (symmetric PSD).
+    ///
+    /// # Errors
+    /// Missing or repeated axis, wrong size, `W` not finite, symmetric and PSD; overflow.
+    fn add_window(&mut self, axes: &[Axis], w: &[f64]) -> Result<(), CovError> {
+        let (idx, k) = resolve(self.dim(), "add_window", axes)?;
+        let wm = block_from_slice("add_window", "W", k, w)?;
+        self.raw_add_window("add_window", &idx[..k], &wm)
+    }
+
+    /// Rule 3: convolution along `axes` with a lobe whose spectrum covariance is `S`
+    /// (row-major, `axes.len()²` numbers, symmetric PSD):
+    /// `Σ' = Σ − Σ Pᵀ (S + P Σ Pᵀ)⁻¹ P Σ`, computed without inverting Σ.
+    ///
+    /// The convolved block and the cross terms use the forms `Σ_pp (S+Σ_pp)⁻¹ S` and
+    /// `Σ_op (S+Σ_pp)⁻¹ S`, which are exactly zero for `S = 0` (a perfectly diffuse lobe
+    /// removes all content on those axes) and tend to the identity as `S → ∞` (a mirror:
+    /// callers skip the kernel). A singular `S + Σ_pp` uses the pseudo-inverse.
+    ///
+    /// # Errors
+    /// Missing or repeated axis, wrong size, `S` not finite/symmetric/PSD; overflow.
+    #[inline]
+    fn convolve(&mut self, axes: &[Axis], s: &[f64]) -> Result<(), CovError> {
+        let (idx, k) = resolve(self.dim(), "convolve", axes)?;
+        let sm = match (k, s) {
+            (1, [s1]) => {
+                // One axis: S is a non-negative number; no eigen-check needed.
+                CovError::require_non_negative("convolve", "S", *s1)?;
+                let mut m = [[0.0; MAX]; MAX];
+                m[0][0] = *s1;
+                m
+            }
+            _ => block_from_slice("convolve", "S", k, s)?,
+        };
+        self.raw_lobe("convolve", &idx[..k], &sm)
+    }
+
+    /// Rule 4, in place: integration of the primal over `axes` (lens, shutter, sensor
+    /// angle). The kept block becomes the Schur complement `Σ_kk − Σ_kr Σ_rr⁺ Σ_rk`
+    /// (pseudo-inverse where Σ_rr is singular) and the integrated axes become 0: the
+    /// integrated field no longer depends on them. The same as [`Spectrum::convolve`]
+    /// with `S = 0`.
+    ///
+    /// # Errors
+    /// Missing or repeated axis.
+    #[inline]
+    fn integrate(&mut self, axes: &[Axis]) -> Result<(), CovError> {
+        let (idx, k) = resolve(self.dim(), "integrate", axes)?;
+        self.raw_lobe("integrate", &idx[..k], &[[0.0; MAX]; MAX])
+    }
 }
 
-impl<const N: usize> Spectrum<N> for CovFactor<N> {
-    fn form(&self) -> Form {
-        Form::SquareRoot
+/// The (position, direction) pairs of layout `n` (see [`Spectrum::transverse_pairs`]).
+pub fn transverse_pairs(n: usize) -> &'static [(Axis, Axis)] {
+    if n >= 4 {
+        &[(Axis::X, Axis::U), (Axis::Y, Axis::V)]
+    } else {
+        &[(Axis::X, Axis::U)]
     }
-    fn cov(&self) -> Result<Cov<N>, CovError> {
-        self.to_cov()
+}
+
+/// Reads a `k × k` row-major symmetric PSD block (a window or lobe spectrum).
+pub(crate) fn block_from_slice(op: &str, name: &str, k: usize, w: &[f64]) -> Result<Small, CovError> {
+    if w.len() != k * k {
+        return Err(CovError::Shape {
+            what: format!("{op}: {name}"),
+            expected: format!("{} numbers ({k}×{k} row-major)", k * k),
+            got: format!("{} numbers", w.len()),
+        });
     }
-    fn assign(&mut self, c: &Cov<N>) -> Result<(), CovError> {
-        c.check_finite("assign")?;
-        *self = CovFactor::from_cov(c);
-        Ok(())
-    }
-    fn snapshot(&self) -> Snapshot<N> {
-        Snapshot::SquareRoot(*self)
-    }
-    fn restore(&mut self, s: &Snapshot<N>) {
-        match s {
-            Snapshot::Covariance(c) => *self = CovFactor::from_cov(c),
-            Snapshot::SquareRoot(f) => *self = *f,
+    let mut m = [[0.0; MAX]; MAX];
+    let mut scale = 0.0f64;
+    for a in 0..k {
+        for b in 0..k {
+            let v = CovError::require_finite(op, name, w[a * k + b])?;
+            m[a][b] = v;
+            scale = scale.max(v.abs());
         }
     }
-    fn layout(&mut self) -> SpectrumMut<'_> {
-        layout_arms!(self, CovFactor)
+    for a in 0..k {
+        for b in (a + 1)..k {
+            if (m[a][b] - m[b][a]).abs() > 1e-12 * scale {
+                return Err(CovError::NotSymmetric {
+                    row: a,
+                    col: b,
+                    a: m[a][b],
+                    b: m[b][a],
+                });
+            }
+            let avg = 0.5 * (m[a][b] + m[b][a]);
+            m[a][b] = avg;
+            m[b][a] = avg;
+        }
     }
-    delegate_kernels!();
+    let (vals, _) = sym_eigen(k, &m);
+    let tol = PSD_RTOL * vals[..k].iter().fold(0.0f64, |acc, v| acc.max(v.abs()));
+    if vals[0] < -tol {
+        return Err(CovError::NotPsd {
+            min_eigenvalue: vals[0],
+            tolerance: -tol,
+        });
+    }
+    Ok(m)
+}
+
+/// The indices of `axes` in layout `n` (at most `n`, distinct), for kernel `op`.
+pub(crate) fn resolve(n: usize, op: &str, axes: &[Axis]) -> Result<([usize; MAX], usize), CovError> {
+    let mut idx = [0usize; MAX];
+    if axes.is_empty() || axes.len() > n {
+        return Err(CovError::Shape {
+            what: op.into(),
+            expected: format!("1 to {n} axes"),
+            got: format!("{} axes", axes.len()),
+        });
+    }
+    for (a, axis) in axes.iter().enumerate() {
+        idx[a] = axis_index(n, *axis)?;
+        if idx[..a].contains(&idx[a]) {
+            return Err(CovError::Shape {
+                what: op.into(),
+                expected: "distinct axes".into(),
+                got: format!("`{axis}` twice"),
+            });
+        }
+    }
+    Ok((idx, axes.len()))
+}
+
+/// The indices of two different axes `a`, `b` of layout `n`, for kernel `op`.
+#[inline]
+pub(crate) fn two_axes(n: usize, op: &str, a: Axis, b: Axis) -> Result<(usize, usize), CovError> {
+    let (i, j) = (axis_index(n, a)?, axis_index(n, b)?);
+    if i == j {
+        return Err(CovError::Shape {
+            what: op.into(),
+            expected: "two different axes".into(),
+            got: format!("{a} and {b}"),
+        });
+    }
+    Ok((i, j))
 }

@@ -98,7 +98,7 @@ fn lobe_limits_a_huge_bandwidth_in_both_forms() {
         let expect_uu = big * s / (s + big);
         let expect_xu = 0.3 * big * s / (s + big);
         for form in [Form::Covariance, Form::SquareRoot] {
-            let r = Chain::<2>::new().with(Lobe(s)).eval_in(form, c).unwrap();
+            let r = Chain::new().with(Lobe(s)).eval_in(form, c).unwrap();
             let uu = r.get(1, 1);
             assert!(
                 (uu / expect_uu - 1.0).abs() < 1e-14,
@@ -113,24 +113,24 @@ fn lobe_limits_a_huge_bandwidth_in_both_forms() {
 
 #[derive(Debug)]
 struct Lobe(f64);
-impl<const N: usize> Operator<N> for Lobe {
-    fn apply(&self, c: &mut dyn Spectrum<N>) -> Result<(), CovError> {
+impl Operator for Lobe {
+    fn apply(&self, c: &mut dyn Spectrum) -> Result<(), CovError> {
         c.convolve(&[Axis::U], &[self.0])
     }
 }
 
 #[derive(Debug)]
 struct Travel(f64);
-impl<const N: usize> Operator<N> for Travel {
-    fn apply(&self, c: &mut dyn Spectrum<N>) -> Result<(), CovError> {
+impl Operator for Travel {
+    fn apply(&self, c: &mut dyn Spectrum) -> Result<(), CovError> {
         c.shear(Axis::X, Axis::U, -self.0)
     }
 }
 
 #[derive(Debug)]
 struct Diffuse;
-impl<const N: usize> Operator<N> for Diffuse {
-    fn apply(&self, c: &mut dyn Spectrum<N>) -> Result<(), CovError> {
+impl Operator for Diffuse {
+    fn apply(&self, c: &mut dyn Spectrum) -> Result<(), CovError> {
         c.convolve(&[Axis::U], &[0.0])
     }
 }
@@ -140,10 +140,7 @@ impl<const N: usize> Operator<N> for Diffuse {
 #[test]
 fn dirac_through_diffuse_is_exactly_zero() {
     let dirac = Cov::<2>::dirac(1.0, 1e-6).unwrap();
-    let chain = Chain::<2>::new()
-        .with(Travel(2.0))
-        .with(Diffuse)
-        .with(Travel(1e3));
+    let chain = Chain::new().with(Travel(2.0)).with(Diffuse).with(Travel(1e3));
     for form in [Form::Covariance, Form::SquareRoot] {
         let r = chain.eval_in(form, dirac).unwrap();
         assert_eq!(r, Cov::<2>::zeros(), "{form:?}: {r}");
@@ -156,7 +153,7 @@ fn dirac_through_diffuse_is_exactly_zero() {
 fn overflow_is_a_typed_error_and_leaves_the_start() {
     let c = Cov::<2>::from_matrix(&SMatrix::<f64, 2, 2>::new(1e300, 0.0, 0.0, 1e300)).unwrap();
     for form in [Form::Covariance, Form::SquareRoot] {
-        let err = Chain::<2>::new().with(Travel(1e10)).eval_in(form, c).unwrap_err();
+        let err = Chain::new().with(Travel(1e10)).eval_in(form, c).unwrap_err();
         assert!(
             err.to_string().contains("overflow") || err.to_string().contains("finite"),
             "{form:?}: {err}"
@@ -166,9 +163,9 @@ fn overflow_is_a_typed_error_and_leaves_the_start() {
     let mut f = CovFactor::from_cov(&Cov::<2>::gaussian([0.1, 0.2]).unwrap());
     f.shear(Axis::X, Axis::U, 0.7).unwrap();
     let before = f;
-    let chain = Chain::<2>::new().with(Travel(1.0)).with(Travel(f64::MAX));
-    let s: &mut dyn Spectrum<2> = &mut f;
-    assert!(Operator::<2>::apply(&chain, s).is_err());
+    let chain = Chain::new().with(Travel(1.0)).with(Travel(f64::MAX));
+    let s: &mut dyn Spectrum = &mut f;
+    assert!(Operator::apply(&chain, s).is_err());
     assert_eq!(f, before);
 }
 

@@ -59,7 +59,7 @@ fn assert_psd_sym<const N: usize>(c: &Cov<N>, what: &str) {
 fn run<const N: usize>(
     form: Form,
     c: &Cov<N>,
-    k: impl Fn(&mut dyn Spectrum<N>) -> Result<(), cov_core::CovError>,
+    k: impl Fn(&mut dyn Spectrum) -> Result<(), cov_core::CovError>,
 ) -> Cov<N> {
     match form {
         Form::Covariance => {
@@ -140,7 +140,7 @@ fn check_all<const N: usize>(
 
     // dense congruence
     let am = SMatrix::<f64, N, N>::from_fn(|r, q| a_entries[r * N + q]);
-    let c4 = run(form, &c, |x| x.congruence(&am));
+    let c4 = run(form, &c, |x| x.congruence(am.transpose().as_slice()));
     let ad = DMatrix::from_fn(N, N, |r, q| am[(r, q)]);
     let e = rel_err(&dense(&c4), &congruence_ref(&s0, &ad));
     assert!(e <= REL, "congruence N={N}: {e}");

@@ -10,12 +10,19 @@
 //! against ray tracing: a convex mirror (curvature, mirror symmetry, inverse curvature)
 //! turns parallel rays at offset `x` by `2x/R` away from the axis.
 //!
-//! | operator | parameter | unit | domain | meaning |
+//! Parameters, as written in a path file (`covtrace list` prints the same):
+//!
+//! <!-- parameters: generated from the specs (`COVTRACE_BLESS=1 cargo test --test param_tables`) -->
+//! | operator | parameter | unit | default | meaning |
 //! |---|---|---|---|---|
-//! | [`Curvature`] | `kx` | 1/m | finite | principal curvature along the principal direction |
-//! | [`Curvature`] | `ky` | 1/m | finite | the other principal curvature (3D) |
-//! | [`Curvature`] | `angle` | rad | finite | angle from the frame's `x` to the first principal direction (3D) |
-//! | [`CurvatureTensor`] | `kxx`, `kxy`, `kyy` | 1/m | finite | the tensor `K` in the frame (the dense form) |
+//! | `Curvature` | `k` | 1/m | optional | Isotropic curvature (> 0 convex). |
+//! |  | `kx` | 1/m | optional | First principal curvature, along `angle`. |
+//! |  | `ky` | 1/m | optional | Second principal curvature, across `angle`. |
+//! |  | `angle` | rad | optional | Angle of the first principal direction from x. |
+//! | `CurvatureTensor` | `kxx` | 1/m | required | `K_xx`, finite. |
+//! |  | `kxy` | 1/m | optional | `K_xy`, finite. |
+//! |  | `kyy` | 1/m | optional | `K_yy`, finite. |
+//! <!-- end of parameters -->
 //!
 //! An anisotropic curvature (`kx ≠ ky` or `angle ≠ 0`) needs the 3D layout; an isotropic
 //! one works in every layout.
@@ -25,7 +32,7 @@
 //! use cov_curvature::Curvature;
 //!
 //! let mut c = Cov::<4>::gaussian([0.01, 0.01, f64::INFINITY, f64::INFINITY])?;
-//! Operator::<4>::apply(&Curvature::anisotropic(2.0, -0.5, 0.3)?, &mut c)?;
+//! Operator::apply(&Curvature::anisotropic(2.0, -0.5, 0.3)?, &mut c)?;
 //! assert!(c.validity().is_valid());
 //! # Ok::<(), cov_core::CovError>(())
 //! ```
@@ -51,7 +58,7 @@
 
 pub mod spec;
 
-use cov_core::{Axis, AxisSet, Cov, CovError, Operator, Spectrum};
+use cov_core::{Axis, AxisSet, CovError, Operator, Spectrum};
 
 /// Curvature by principal curvatures and direction.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -80,9 +87,9 @@ impl Curvature {
     /// Non-finite parameters.
     pub fn anisotropic(kx: f64, ky: f64, angle: f64) -> Result<Self, CovError> {
         Ok(Curvature {
-            kx: CovError::check_finite(Self::NAME, "kx", kx)?,
-            ky: CovError::check_finite(Self::NAME, "ky", ky)?,
-            angle: CovError::check_finite(Self::NAME, "angle", angle)?,
+            kx: CovError::require_finite(Self::NAME, "kx", kx)?,
+            ky: CovError::require_finite(Self::NAME, "ky", ky)?,
+            angle: CovError::require_finite(Self::NAME, "angle", angle)?,
         })
     }
 
@@ -117,26 +124,21 @@ impl Curvature {
     ///
     /// # Errors
     /// `cos` not in (0, 1], `sign` not finite, overflow.
-    pub fn apply_oblique<const N: usize>(
-        &self,
-        cov: &mut dyn Spectrum<N>,
-        cos: f64,
-        sign: f64,
-    ) -> Result<(), CovError> {
-        CovError::check_range(
+    pub fn apply_oblique(&self, cov: &mut dyn Spectrum, cos: f64, sign: f64) -> Result<(), CovError> {
+        CovError::require_range(
             Self::NAME,
             "cos",
             cos,
             |c| c > 0.0 && c <= 1.0,
             "must be in (0, 1]",
         )?;
-        CovError::check_finite(Self::NAME, "sign", sign)?;
+        CovError::require_finite(Self::NAME, "sign", sign)?;
         let (kxx, kxy, kyy) = self.tensor();
-        if !Cov::<N>::has(Axis::Y) {
+        if !cov.has(Axis::Y) {
             if !self.is_isotropic() {
                 return Err(CovError::MissingAxis {
                     axis: Axis::Y,
-                    layout: N,
+                    layout: cov.dim(),
                 });
             }
             return cov.shear(Axis::U, Axis::X, sign * kxx);
@@ -153,10 +155,10 @@ impl Curvature {
     }
 }
 
-impl<const N: usize> Operator<N> for Curvature {
-    fn apply(&self, cov: &mut dyn Spectrum<N>) -> Result<(), CovError> {
+impl Operator for Curvature {
+    fn apply(&self, cov: &mut dyn Spectrum) -> Result<(), CovError> {
         if self.is_isotropic() {
-            for &(p, d) in Cov::<N>::transverse_pairs() {
+            for &(p, d) in cov.transverse_pairs() {
                 cov.shear(d, p, self.kx)?;
             }
             return Ok(());
@@ -166,9 +168,6 @@ impl<const N: usize> Operator<N> for Curvature {
         cov.shear(Axis::U, Axis::X, self.kx)?;
         cov.shear(Axis::V, Axis::Y, self.ky)?;
         cov.rotate_frame(-self.angle)
-    }
-    fn name(&self) -> &str {
-        Self::NAME
     }
     fn requires(&self) -> AxisSet {
         if self.is_isotropic() {
@@ -195,19 +194,19 @@ impl CurvatureTensor {
     pub fn new(kxx: f64, kxy: f64, kyy: f64) -> Result<Self, CovError> {
         Ok(CurvatureTensor {
             k: [
-                CovError::check_finite(Self::NAME, "kxx", kxx)?,
-                CovError::check_finite(Self::NAME, "kxy", kxy)?,
-                CovError::check_finite(Self::NAME, "kyy", kyy)?,
+                CovError::require_finite(Self::NAME, "kxx", kxx)?,
+                CovError::require_finite(Self::NAME, "kxy", kxy)?,
+                CovError::require_finite(Self::NAME, "kyy", kyy)?,
             ],
         })
     }
 }
 
-impl<const N: usize> Operator<N> for CurvatureTensor {
-    fn apply(&self, cov: &mut dyn Spectrum<N>) -> Result<(), CovError> {
+impl Operator for CurvatureTensor {
+    fn apply(&self, cov: &mut dyn Spectrum) -> Result<(), CovError> {
         let [kxx, kxy, kyy] = self.k;
         cov.shear(Axis::U, Axis::X, kxx)?;
-        if Cov::<N>::has(Axis::Y) {
+        if cov.has(Axis::Y) {
             // The four shears commute: each adds position to direction.
             cov.shear(Axis::U, Axis::Y, kxy)?;
             cov.shear(Axis::V, Axis::X, kxy)?;
@@ -215,13 +214,10 @@ impl<const N: usize> Operator<N> for CurvatureTensor {
         } else if kxy != 0.0 || kyy != 0.0 {
             return Err(CovError::MissingAxis {
                 axis: Axis::Y,
-                layout: N,
+                layout: cov.dim(),
             });
         }
         Ok(())
-    }
-    fn name(&self) -> &str {
-        Self::NAME
     }
     fn requires(&self) -> AxisSet {
         if self.k[1] != 0.0 || self.k[2] != 0.0 {

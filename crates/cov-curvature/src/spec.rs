@@ -1,27 +1,32 @@
 //! RON parameters of the curvature operators.
 
 use cov_core::CovError;
-use cov_path::{OperatorSpec, Param, Registry};
+use cov_core::{OperatorSpec, Registrar};
 use serde::Deserialize;
 
 use crate::{Curvature, CurvatureTensor};
 
 /// `Curvature(k: 2.0)` (isotropic) or `Curvature(kx: 2.0, ky: -1.0, angle: 0.3)`.
 /// Also the form of the `curvature` field of composite operators: `(k: 2.0)`.
-#[derive(Clone, Copy, Debug, Default, Deserialize)]
+#[derive(Clone, Copy, Debug, Default, Deserialize, OperatorSpec)]
 #[serde(deny_unknown_fields)]
+#[operator(summary = "surface curvature in the surface frame, l(x, u + k·x)")]
 pub struct CurvatureSpec {
-    /// Isotropic curvature (1/m).
+    /// Isotropic curvature (> 0 convex).
     #[serde(default)]
+    #[param(unit = "1/m", default)]
     pub k: Option<f64>,
-    /// First principal curvature (1/m).
+    /// First principal curvature, along `angle`.
     #[serde(default)]
+    #[param(unit = "1/m", default)]
     pub kx: Option<f64>,
-    /// Second principal curvature (1/m).
+    /// Second principal curvature, across `angle`.
     #[serde(default)]
+    #[param(unit = "1/m", default)]
     pub ky: Option<f64>,
-    /// Angle of the first principal direction from x (rad).
+    /// Angle of the first principal direction from x.
     #[serde(default)]
+    #[param(unit = "rad", default)]
     pub angle: Option<f64>,
 }
 
@@ -46,78 +51,36 @@ impl CurvatureSpec {
     }
 }
 
-impl OperatorSpec for CurvatureSpec {
-    const NAME: &'static str = Curvature::NAME;
-    const SUMMARY: &'static str = "surface curvature in the surface frame, l(x, u + k·x)";
-    const PARAMS: &'static [Param] = &[
-        Param {
-            name: "k",
-            unit: "1/m",
-            doc: "isotropic curvature (> 0 convex)",
-        },
-        Param {
-            name: "kx",
-            unit: "1/m",
-            doc: "principal curvature along `angle`",
-        },
-        Param {
-            name: "ky",
-            unit: "1/m",
-            doc: "principal curvature across it",
-        },
-        Param {
-            name: "angle",
-            unit: "rad",
-            doc: "principal direction from x",
-        },
-    ];
-    type Op = Curvature;
-    fn build(self) -> Result<Curvature, CovError> {
-        self.to_curvature()
+impl TryFrom<CurvatureSpec> for Curvature {
+    type Error = CovError;
+    fn try_from(spec: CurvatureSpec) -> Result<Curvature, CovError> {
+        spec.to_curvature()
     }
 }
 
 /// `CurvatureTensor(kxx: 1, kxy: 0.2, kyy: -0.5)`.
-#[derive(Debug, Deserialize)]
-#[serde(deny_unknown_fields)]
+#[derive(Debug, OperatorSpec)]
+#[operator(summary = "surface curvature given by its tensor in the frame")]
 pub struct CurvatureTensorSpec {
-    /// K_xx (1/m).
+    /// `K_xx`, finite.
+    #[param(unit = "1/m")]
     pub kxx: f64,
-    /// K_xy (1/m).
-    #[serde(default)]
+    /// `K_xy`, finite.
+    #[param(unit = "1/m", default)]
     pub kxy: f64,
-    /// K_yy (1/m).
-    #[serde(default)]
+    /// `K_yy`, finite.
+    #[param(unit = "1/m", default)]
     pub kyy: f64,
 }
 
-impl OperatorSpec for CurvatureTensorSpec {
-    const NAME: &'static str = CurvatureTensor::NAME;
-    const SUMMARY: &'static str = "surface curvature given by its tensor in the frame";
-    const PARAMS: &'static [Param] = &[
-        Param {
-            name: "kxx",
-            unit: "1/m",
-            doc: "finite",
-        },
-        Param {
-            name: "kxy",
-            unit: "1/m",
-            doc: "finite, default 0",
-        },
-        Param {
-            name: "kyy",
-            unit: "1/m",
-            doc: "finite, default 0",
-        },
-    ];
-    type Op = CurvatureTensor;
-    fn build(self) -> Result<CurvatureTensor, CovError> {
-        CurvatureTensor::new(self.kxx, self.kxy, self.kyy)
+impl TryFrom<CurvatureTensorSpec> for CurvatureTensor {
+    type Error = CovError;
+    fn try_from(spec: CurvatureTensorSpec) -> Result<CurvatureTensor, CovError> {
+        CurvatureTensor::new(spec.kxx, spec.kxy, spec.kyy)
     }
 }
 
 /// Registers this crate's operators.
-pub fn register(r: &mut Registry) {
-    r.register::<CurvatureSpec>().register::<CurvatureTensorSpec>();
+pub fn register<R: Registrar>(r: &mut R) {
+    r.add::<CurvatureSpec>().add::<CurvatureTensorSpec>();
 }

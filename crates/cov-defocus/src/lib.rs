@@ -12,12 +12,16 @@
 //! the singular map `(x, u) ↦ (0, x/d_s)`, i.e. `Σ'_xx = Σ_uu / d_s²` and nothing left in
 //! angle. No NaN, no infinity.
 //!
-//! | operator | parameter | unit | domain | meaning |
+//! Parameters, as written in a path file (`covtrace list` prints the same):
+//!
+//! <!-- parameters: generated from the specs (`COVTRACE_BLESS=1 cargo test --test param_tables`) -->
+//! | operator | parameter | unit | default | meaning |
 //! |---|---|---|---|---|
-//! | [`ThinLens`] | `focal_length` | m | > 0 | `f` |
-//! | [`ThinLens`] | `aperture` | m | > 0 | std of the Gaussian aperture (a disk of radius `R`: `R/2`, equal variance) |
-//! | [`ThinLens`] | `focus_distance` | m | > `f` | distance of the plane in focus |
-//! | [`Pinhole`] | `sensor_distance` | m | > 0 | pinhole to sensor |
+//! | `ThinLens` | `focal_length` | m | required | Focal length, > 0. |
+//! |  | `aperture` | m | required | Std of the aperture, > 0 (a disk of radius R: R/2). |
+//! |  | `focus_distance` | m | required | Focus distance, > `focal_length`. |
+//! | `Pinhole` | `sensor_distance` | m | required | Pinhole to sensor, > 0. |
+//! <!-- end of parameters -->
 //!
 //! **Worked example**: `f = 50 mm`, focus at `2 m` → `d_s = 0.05·2/1.95 = 51.28 mm`. A point
 //! at 1 m (out of focus) is imaged at `d_i = 52.63 mm`; on the sensor its rays spread over
@@ -31,7 +35,7 @@
 //! let lens = ThinLens::new(0.05, 0.005, 2.0)?;
 //! assert!((lens.sensor_distance() - 0.05 * 2.0 / 1.95).abs() < 1e-15);
 //! let mut c = Cov::<2>::zeros();
-//! Operator::<2>::apply(&lens, &mut c)?;
+//! Operator::apply(&lens, &mut c)?;
 //! assert!(c.validity().is_valid());
 //! # Ok::<(), cov_core::CovError>(())
 //! ```
@@ -51,7 +55,7 @@
 
 pub mod spec;
 
-use cov_core::{Cov, CovError, FOUR_PI_SQ, Operator, Spectrum};
+use cov_core::{CovError, FOUR_PI_SQ, Operator, Spectrum};
 
 /// A thin lens with a Gaussian aperture, focused at `focus_distance`; ends at the sensor.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -69,9 +73,9 @@ impl ThinLens {
     /// Non-positive or non-finite parameters, or `focus_distance ≤ focal_length` (no real
     /// image).
     pub fn new(focal_length: f64, aperture: f64, focus_distance: f64) -> Result<Self, CovError> {
-        CovError::check_positive(Self::NAME, "focal_length", focal_length)?;
-        CovError::check_positive(Self::NAME, "aperture", aperture)?;
-        CovError::check_range(
+        CovError::require_positive(Self::NAME, "focal_length", focal_length)?;
+        CovError::require_positive(Self::NAME, "aperture", aperture)?;
+        CovError::require_range(
             Self::NAME,
             "focus_distance",
             focus_distance,
@@ -79,7 +83,7 @@ impl ThinLens {
             &format!("must be > focal_length = {focal_length} (a real image)"),
         )?;
         let d_s = focal_length * focus_distance / (focus_distance - focal_length);
-        CovError::check_finite(Self::NAME, "sensor distance", d_s)?;
+        CovError::require_finite(Self::NAME, "sensor distance", d_s)?;
         Ok(ThinLens {
             f: focal_length,
             aperture,
@@ -98,18 +102,15 @@ impl ThinLens {
     }
 }
 
-impl<const N: usize> Operator<N> for ThinLens {
-    fn apply(&self, cov: &mut dyn Spectrum<N>) -> Result<(), CovError> {
+impl Operator for ThinLens {
+    fn apply(&self, cov: &mut dyn Spectrum) -> Result<(), CovError> {
         let w = 1.0 / (FOUR_PI_SQ * self.aperture * self.aperture);
-        for &(x, u) in Cov::<N>::transverse_pairs() {
+        for &(x, u) in cov.transverse_pairs() {
             cov.add_variance(x, w)?;
             cov.shear(u, x, 1.0 / self.f)?;
             cov.shear(x, u, -self.d_s)?;
         }
         Ok(())
-    }
-    fn name(&self) -> &str {
-        Self::NAME
     }
 }
 
@@ -127,24 +128,26 @@ impl Pinhole {
     /// Non-positive or non-finite distance.
     pub fn new(sensor_distance: f64) -> Result<Self, CovError> {
         Ok(Pinhole {
-            d_s: CovError::check_positive(Self::NAME, "sensor_distance", sensor_distance)?,
+            d_s: CovError::require_positive(Self::NAME, "sensor_distance", sensor_distance)?,
         })
     }
 }
 
-impl<const N: usize> Operator<N> for Pinhole {
-    fn apply(&self, cov: &mut dyn Spectrum<N>) -> Result<(), CovError> {
+impl Operator for Pinhole {
+    fn apply(&self, cov: &mut dyn Spectrum) -> Result<(), CovError> {
         // (x, u) ↦ (0, x/d_s) on each pair; time untouched.
-        let mut a = nalgebra::SMatrix::<f64, N, N>::identity();
-        for &(x, u) in Cov::<N>::transverse_pairs() {
-            let (ix, iu) = (Cov::<N>::index(x)?, Cov::<N>::index(u)?);
-            a[(ix, ix)] = 0.0;
-            a[(iu, iu)] = 0.0;
-            a[(iu, ix)] = 1.0 / self.d_s;
+        // A (row-major), the identity but on the pairs.
+        let n = cov.dim();
+        let mut a = [0.0; 25];
+        for i in 0..n {
+            a[i * n + i] = 1.0;
         }
-        cov.congruence(&a)
-    }
-    fn name(&self) -> &str {
-        Self::NAME
+        for &(x, u) in cov.transverse_pairs() {
+            let (ix, iu) = (cov.index(x)?, cov.index(u)?);
+            a[ix * n + ix] = 0.0;
+            a[iu * n + iu] = 0.0;
+            a[iu * n + ix] = 1.0 / self.d_s;
+        }
+        cov.congruence(&a[..n * n])
     }
 }

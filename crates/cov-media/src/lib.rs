@@ -34,15 +34,20 @@
 //! 4.30 (curvature). The **moment fit is the default**. Both are crude: the HG lobe is
 //! heavy-tailed and, off its peak, asymmetric.
 //!
-//! | operator | parameter | unit | domain | meaning |
+//! Parameters, as written in a path file (`covtrace list` prints the same):
+//!
+//! <!-- parameters: generated from the specs (`COVTRACE_BLESS=1 cargo test --test param_tables`) -->
+//! | operator | parameter | unit | default | meaning |
 //! |---|---|---|---|---|
-//! | [`Absorption`] | `length` | m | ≥ 0 | segment length `L` |
-//! | [`Absorption`] | `hessian` | 1/m³ | finite, `[hxx]` or `[hxx, hxy, hyy]` | Hessian of `σ_t` across the ray |
-//! | [`Segment`] | same | | | absorption over the segment, then travel `L` |
-//! | [`Scatter`] | `angle` | rad | `[0, π]` | scattering angle `θ` |
-//! | [`Scatter`] | `phase` | | `HenyeyGreenstein(g)` with `g ∈ (−1, 1)`, or `Tabulated(angles, values)` | the phase function |
-//! | [`Scatter`] | `fit` | | `Moment` (default) or `Curvature` | Gaussian fit of the lobe |
-//! | [`Scatter`] | `azimuth` | rad | finite, default 0 | frame rotation turning `x` into the scattering plane (3D) |
+//! | `Absorption` | `length` | m | required | Length of the segment, ≥ 0. |
+//! |  | `hessian` | 1/m³ | required | Hessian of σ_t across the ray: `[hxx]` or `[hxx, hxy, hyy]`. |
+//! | `Segment` | `length` | m | required | Length of the segment, ≥ 0. |
+//! |  | `hessian` | 1/m³ | required | Hessian of σ_t across the ray: `[hxx]` or `[hxx, hxy, hyy]`. |
+//! | `Scatter` | `angle` | rad | required | Scattering angle, in [0, π]. |
+//! |  | `phase` | – | required | Phase function: `HenyeyGreenstein(g)` or `Tabulated(angles, values)`. |
+//! |  | `fit` | – | optional | How the phase lobe is fitted: `Moment` (default) or `Curvature`. |
+//! |  | `azimuth` | rad | optional | Frame rotation into the scattering plane (3D). |
+//! <!-- end of parameters -->
 //!
 //! **Worked example**: fog with `H = 0.5 /m³` over `L = 2 m`: `Q_xx = L·H = 1`, `Q_xu = 1`,
 //! `Q_uu = 4/3`, i.e. `Σ_xx += 1/4π² = 0.0253 (cycles/m)²`. A forward HG scatter with
@@ -55,9 +60,9 @@
 //!
 //! let mut c = Cov::<2>::gaussian([0.1, 0.2])?;
 //! let before = c.get(0, 0);
-//! Operator::<2>::apply(&Absorption::new(2.0, [0.5, 0.0, 0.0])?, &mut c)?;
+//! Operator::apply(&Absorption::new(2.0, [0.5, 0.0, 0.0])?, &mut c)?;
 //! assert!((c.get(0, 0) - before - 1.0 / (4.0 * std::f64::consts::PI.powi(2))).abs() < 1e-12);
-//! Operator::<2>::apply(&Scatter::new(0.0, Phase::henyey_greenstein(0.8)?, Fit::Moment, 0.0)?, &mut c)?;
+//! Operator::apply(&Scatter::new(0.0, Phase::henyey_greenstein(0.8)?, Fit::Moment, 0.0)?, &mut c)?;
 //! assert!(c.validity().is_valid());
 //! # Ok::<(), cov_core::CovError>(())
 //! ```
@@ -83,7 +88,7 @@ pub mod spec;
 
 use std::f64::consts::{FRAC_PI_2, PI};
 
-use cov_core::{Axis, AxisSet, Cov, CovError, FOUR_PI_SQ, Operator, Spectrum};
+use cov_core::{Axis, AxisSet, CovError, FOUR_PI_SQ, Operator, Spectrum};
 
 /// Absorption over a segment of a heterogeneous medium, as a window at its start.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -101,9 +106,9 @@ impl Absorption {
     /// # Errors
     /// Negative or non-finite length, non-finite Hessian.
     pub fn new(length: f64, hessian: [f64; 3]) -> Result<Self, CovError> {
-        CovError::check_non_negative(Self::NAME, "length", length)?;
+        CovError::require_non_negative(Self::NAME, "length", length)?;
         for (name, v) in ["hxx", "hxy", "hyy"].iter().zip(hessian) {
-            CovError::check_finite(Self::NAME, name, v)?;
+            CovError::require_finite(Self::NAME, name, v)?;
         }
         Ok(Absorption {
             length,
@@ -140,12 +145,12 @@ fn psd_part([a, b, c]: [f64; 3]) -> [f64; 3] {
     [l1 * vx * vx / n2, l1 * vx * vy / n2, l1 * vy * vy / n2]
 }
 
-impl<const N: usize> Operator<N> for Absorption {
-    fn apply(&self, cov: &mut dyn Spectrum<N>) -> Result<(), CovError> {
+impl Operator for Absorption {
+    fn apply(&self, cov: &mut dyn Spectrum) -> Result<(), CovError> {
         let l = self.length;
         let (q0, q1, q2) = (l, 0.5 * l * l, l * l * l / 3.0);
         let [hxx, hxy, hyy] = self.h;
-        if Cov::<N>::has(Axis::Y) {
+        if cov.has(Axis::Y) {
             let hm = [[hxx, hxy], [hxy, hyy]];
             let qk = [[q0, q1], [q1, q2]];
             // Axes (x, y, u, v): entry (2a+i, 2b+j) ordering → ((pos/dir a, axis i), …).
@@ -161,9 +166,6 @@ impl<const N: usize> Operator<N> for Absorption {
             let w = [q0 * hxx, q1 * hxx, q1 * hxx, q2 * hxx].map(|v| v / FOUR_PI_SQ);
             cov.add_window(&[Axis::X, Axis::U], &w)
         }
-    }
-    fn name(&self) -> &str {
-        Self::NAME
     }
     fn requires(&self) -> AxisSet {
         if self.h[1] != 0.0 || self.h[2] != 0.0 {
@@ -193,19 +195,16 @@ impl Segment {
     }
 }
 
-impl<const N: usize> Operator<N> for Segment {
-    fn apply(&self, cov: &mut dyn Spectrum<N>) -> Result<(), CovError> {
-        Operator::<N>::apply(&self.absorption, cov)?;
-        for &(p, d) in Cov::<N>::transverse_pairs() {
+impl Operator for Segment {
+    fn apply(&self, cov: &mut dyn Spectrum) -> Result<(), CovError> {
+        Operator::apply(&self.absorption, cov)?;
+        for &(p, d) in cov.transverse_pairs() {
             cov.shear(p, d, -self.absorption.length)?;
         }
         Ok(())
     }
-    fn name(&self) -> &str {
-        Self::NAME
-    }
     fn requires(&self) -> AxisSet {
-        Operator::<N>::requires(&self.absorption)
+        Operator::requires(&self.absorption)
     }
 }
 
@@ -245,7 +244,7 @@ impl Phase {
     pub fn validated(self) -> Result<Phase, CovError> {
         match &self {
             Phase::HenyeyGreenstein { g } => {
-                CovError::check_range(
+                CovError::require_range(
                     "HenyeyGreenstein",
                     "g",
                     *g,
@@ -262,8 +261,8 @@ impl Phase {
                     });
                 }
                 for (k, (a, v)) in angles.iter().zip(values).enumerate() {
-                    CovError::check_finite("Tabulated", &format!("angles[{k}]"), *a)?;
-                    CovError::check_positive("Tabulated", &format!("values[{k}]"), *v)?;
+                    CovError::require_finite("Tabulated", &format!("angles[{k}]"), *a)?;
+                    CovError::require_positive("Tabulated", &format!("values[{k}]"), *v)?;
                     if k > 0 && *a <= angles[k - 1] {
                         return Err(CovError::OutOfRange {
                             operator: "Tabulated".into(),
@@ -365,14 +364,14 @@ impl Scatter {
     /// # Errors
     /// `angle` outside [0, π], non-finite `azimuth`, invalid phase function.
     pub fn new(angle: f64, phase: Phase, fit: Fit, azimuth: f64) -> Result<Self, CovError> {
-        CovError::check_range(
+        CovError::require_range(
             Self::NAME,
             "angle",
             angle,
             |a| (0.0..=PI).contains(&a),
             "must be in [0, π]",
         )?;
-        CovError::check_finite(Self::NAME, "azimuth", azimuth)?;
+        CovError::require_finite(Self::NAME, "azimuth", azimuth)?;
         let phase = phase.validated()?;
         let var = match fit {
             Fit::Curvature => {
@@ -398,13 +397,13 @@ impl Scatter {
     }
 }
 
-impl<const N: usize> Operator<N> for Scatter {
-    fn apply(&self, cov: &mut dyn Spectrum<N>) -> Result<(), CovError> {
+impl Operator for Scatter {
+    fn apply(&self, cov: &mut dyn Spectrum) -> Result<(), CovError> {
         if self.azimuth != 0.0 {
             cov.rotate_frame(self.azimuth)?;
         }
         cov.scale(Axis::X, self.cos)?;
-        for (&axis, var) in Cov::<N>::direction_axes().iter().zip(self.var) {
+        for (&axis, var) in cov.direction_axes().iter().zip(self.var) {
             // S = 1/(4π² var): 0 when the lobe has no peak (var = ∞).
             let s = if var.is_infinite() {
                 0.0
@@ -414,9 +413,6 @@ impl<const N: usize> Operator<N> for Scatter {
             cov.convolve(&[axis], &[s])?;
         }
         Ok(())
-    }
-    fn name(&self) -> &str {
-        Self::NAME
     }
     fn requires(&self) -> AxisSet {
         if self.azimuth != 0.0 {

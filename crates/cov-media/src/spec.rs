@@ -1,8 +1,7 @@
 //! RON parameters of the media operators.
 
 use cov_core::CovError;
-use cov_path::{OperatorSpec, Param, Registry};
-use serde::Deserialize;
+use cov_core::{OperatorSpec, Registrar};
 
 use crate::{Absorption, Fit, Phase, Scatter, Segment};
 
@@ -19,113 +18,75 @@ fn hessian(op: &str, h: &[f64]) -> Result<[f64; 3], CovError> {
 }
 
 /// `Absorption(length: 2.0, hessian: [0.5])`.
-#[derive(Debug, Deserialize)]
-#[serde(deny_unknown_fields)]
+#[derive(Debug, OperatorSpec)]
+#[operator(summary = "absorption across a heterogeneous segment (a window)")]
 pub struct AbsorptionSpec {
-    /// m.
+    /// Length of the segment, ≥ 0.
+    #[param(unit = "m")]
     pub length: f64,
-    /// 1/m³: `[hxx]` or `[hxx, hxy, hyy]`.
+    /// Hessian of σ_t across the ray: `[hxx]` or `[hxx, hxy, hyy]`.
+    #[param(unit = "1/m³")]
     pub hessian: Vec<f64>,
 }
 
-const ABS_PARAMS: &[Param] = &[
-    Param {
-        name: "length",
-        unit: "m",
-        doc: "≥ 0",
-    },
-    Param {
-        name: "hessian",
-        unit: "1/m³",
-        doc: "[hxx] or [hxx, hxy, hyy] of σ_t across the ray",
-    },
-];
-
-impl OperatorSpec for AbsorptionSpec {
-    const NAME: &'static str = Absorption::NAME;
-    const SUMMARY: &'static str = "absorption across a heterogeneous segment (a window)";
-    const PARAMS: &'static [Param] = ABS_PARAMS;
-    type Op = Absorption;
-    fn build(self) -> Result<Absorption, CovError> {
-        Absorption::new(self.length, hessian(Absorption::NAME, &self.hessian)?)
+impl TryFrom<AbsorptionSpec> for Absorption {
+    type Error = CovError;
+    fn try_from(spec: AbsorptionSpec) -> Result<Absorption, CovError> {
+        Absorption::new(spec.length, hessian(Absorption::NAME, &spec.hessian)?)
     }
 }
 
 /// `Segment(length: 2.0, hessian: [0.5])`.
-#[derive(Debug, Deserialize)]
-#[serde(deny_unknown_fields)]
+#[derive(Debug, OperatorSpec)]
+#[operator(summary = "a volumetric segment: absorption then travel")]
 pub struct SegmentSpec {
-    /// m.
+    /// Length of the segment, ≥ 0.
+    #[param(unit = "m")]
     pub length: f64,
-    /// 1/m³.
+    /// Hessian of σ_t across the ray: `[hxx]` or `[hxx, hxy, hyy]`.
+    #[param(unit = "1/m³")]
     pub hessian: Vec<f64>,
 }
 
-impl OperatorSpec for SegmentSpec {
-    const NAME: &'static str = Segment::NAME;
-    const SUMMARY: &'static str = "a volumetric segment: absorption then travel";
-    const PARAMS: &'static [Param] = ABS_PARAMS;
-    type Op = Segment;
-    fn build(self) -> Result<Segment, CovError> {
-        Segment::new(self.length, hessian(Segment::NAME, &self.hessian)?)
+impl TryFrom<SegmentSpec> for Segment {
+    type Error = CovError;
+    fn try_from(spec: SegmentSpec) -> Result<Segment, CovError> {
+        Segment::new(spec.length, hessian(Segment::NAME, &spec.hessian)?)
     }
 }
 
 /// `Scatter(angle: 0.3, phase: HenyeyGreenstein(g: 0.7), fit: Curvature, azimuth: 0.0)`.
-#[derive(Debug, Deserialize)]
-#[serde(deny_unknown_fields)]
+#[derive(Debug, OperatorSpec)]
+#[operator(summary = "scattering at a point: frame alignment and the phase function lobe")]
 pub struct ScatterSpec {
-    /// rad.
+    /// Scattering angle, in [0, π].
+    #[param(unit = "rad")]
     pub angle: f64,
-    /// Phase function.
+    /// Phase function: `HenyeyGreenstein(g)` or `Tabulated(angles, values)`.
     pub phase: Phase,
-    /// Fit (default Moment).
-    #[serde(default)]
+    /// How the phase lobe is fitted: `Moment` (default) or `Curvature`.
+    #[param(default)]
     pub fit: Option<Fit>,
-    /// rad (3D), default 0.
-    #[serde(default)]
+    /// Frame rotation into the scattering plane (3D).
+    #[param(unit = "rad", default)]
     pub azimuth: Option<f64>,
 }
 
-impl OperatorSpec for ScatterSpec {
-    const NAME: &'static str = Scatter::NAME;
-    const SUMMARY: &'static str = "scattering at a point: frame alignment and the phase function lobe";
-    const PARAMS: &'static [Param] = &[
-        Param {
-            name: "angle",
-            unit: "rad",
-            doc: "[0, π]",
-        },
-        Param {
-            name: "phase",
-            unit: "",
-            doc: "HenyeyGreenstein(g) | Tabulated(angles, values)",
-        },
-        Param {
-            name: "fit",
-            unit: "",
-            doc: "Moment (default) | Curvature",
-        },
-        Param {
-            name: "azimuth",
-            unit: "rad",
-            doc: "frame rotation into the scattering plane (3D)",
-        },
-    ];
-    type Op = Scatter;
-    fn build(self) -> Result<Scatter, CovError> {
+impl TryFrom<ScatterSpec> for Scatter {
+    type Error = CovError;
+    fn try_from(spec: ScatterSpec) -> Result<Scatter, CovError> {
         Scatter::new(
-            self.angle,
-            self.phase,
-            self.fit.unwrap_or_default(),
-            self.azimuth.unwrap_or(0.0),
+            spec.angle,
+            spec.phase,
+            spec.fit.unwrap_or_default(),
+            spec.azimuth.unwrap_or(0.0),
         )
     }
 }
 
 /// Registers this crate's operators.
-pub fn register(r: &mut Registry) {
-    r.register::<AbsorptionSpec>()
-        .register::<SegmentSpec>()
-        .register::<ScatterSpec>();
+pub fn register<R: Registrar>(r: &mut R) {
+    r.add::<AbsorptionSpec>()
+        .add::<SegmentSpec>()
+        .add::<ScatterSpec>();
 }

@@ -26,7 +26,7 @@ fn transmittance(length: f64, sigma: impl Fn(f64) -> f64 + Send + Sync + 'static
 fn absorption_matches_ground_truth_and_ignores_constant_and_gradient() {
     for (l, hxx, grad) in [(1.0, 2.0, 0.0), (2.0, 0.5, 3.0), (0.3, 40.0, -5.0)] {
         let mut p = Cov::<2>::gaussian(STDS).unwrap();
-        Operator::<2>::apply(&Absorption::new(l, [hxx, 0.0, 0.0]).unwrap(), &mut p).unwrap();
+        Operator::apply(&Absorption::new(l, [hxx, 0.0, 0.0]).unwrap(), &mut p).unwrap();
         let f = Field::gaussian(&STDS).then(transmittance(l, move |x| 0.7 + grad * x + 0.5 * hxx * x * x));
         let r = compare(&f, &p, &Grid::auto(&p, 64, &[1.0; 2])).unwrap();
         assert!(r.rel_error < 1e-3, "L={l} H={hxx} g={grad}: {:e}", r.rel_error);
@@ -37,7 +37,7 @@ fn absorption_matches_ground_truth_and_ignores_constant_and_gradient() {
 fn segment_is_absorption_then_travel() {
     let (l, hxx) = (1.5, 3.0);
     let mut p = Cov::<2>::gaussian(STDS).unwrap();
-    Operator::<2>::apply(&Segment::new(l, [hxx, 0.0, 0.0]).unwrap(), &mut p).unwrap();
+    Operator::apply(&Segment::new(l, [hxx, 0.0, 0.0]).unwrap(), &mut p).unwrap();
     let f = Field::gaussian(&STDS)
         .then(transmittance(l, move |x| 0.5 * hxx * x * x))
         .then(Primal::travel(2, l));
@@ -50,7 +50,7 @@ fn absorption_in_3d_with_anisotropic_hessian() {
     let (l, h) = (1.0, [2.0, 0.7, 1.0]);
     let stds = [0.15, 0.2, 0.3, 0.25];
     let mut p = Cov::<4>::gaussian(stds).unwrap();
-    Operator::<4>::apply(&Absorption::new(l, h).unwrap(), &mut p).unwrap();
+    Operator::apply(&Absorption::new(l, h).unwrap(), &mut p).unwrap();
     let f = Field::gaussian(&stds).then(Primal::Window(Arc::new(move |z: &[f64]| {
         let n = 64;
         let dh = l / n as f64;
@@ -72,7 +72,7 @@ fn absorption_limits() {
     let start = Cov::<4>::gaussian([0.1, 0.1, 0.2, 0.2]).unwrap();
     let run = |h: [f64; 3], l: f64| {
         let mut c = start;
-        Operator::<4>::apply(&Absorption::new(l, h).unwrap(), &mut c).unwrap();
+        Operator::apply(&Absorption::new(l, h).unwrap(), &mut c).unwrap();
         c
     };
     assert_eq!(run([0.0; 3], 5.0), start, "homogeneous medium: unchanged");
@@ -114,7 +114,7 @@ fn hg_fits_compared_over_g() {
             let mut errs = [0.0; 2];
             for (k, fit) in [Fit::Curvature, Fit::Moment].into_iter().enumerate() {
                 let mut p = Cov::<2>::gaussian(STDS).unwrap();
-                Operator::<2>::apply(
+                Operator::apply(
                     &Scatter::new(theta, Phase::henyey_greenstein(g).unwrap(), fit, 0.0).unwrap(),
                     &mut p,
                 )
@@ -151,7 +151,7 @@ fn hg_limits_and_tabulated() {
     // g = 0: isotropic, no angular content left (either fit).
     for fit in [Fit::Curvature, Fit::Moment] {
         let mut c = Cov::<2>::gaussian(STDS).unwrap();
-        Operator::<2>::apply(
+        Operator::apply(
             &Scatter::new(0.4, Phase::henyey_greenstein(0.0).unwrap(), fit, 0.0).unwrap(),
             &mut c,
         )
@@ -164,7 +164,7 @@ fn hg_limits_and_tabulated() {
         let mut c = Cov::<2>::gaussian(STDS).unwrap();
         let s = Scatter::new(theta, Phase::henyey_greenstein(g).unwrap(), Fit::Curvature, 0.0).unwrap();
         assert!(s.variances()[0] < 1e-10, "{g}: {:?}", s.variances());
-        Operator::<2>::apply(&s, &mut c).unwrap();
+        Operator::apply(&s, &mut c).unwrap();
         assert!(c.validity().is_valid());
     }
     assert!(Phase::henyey_greenstein(1.0).is_err());

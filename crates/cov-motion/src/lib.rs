@@ -11,14 +11,19 @@
 //! is the opposite shears. The x–t correlation this creates is linear in `v`: doubling a
 //! velocity doubles the shear (tested).
 //!
-//! | operator | parameter | unit | domain | meaning |
+//! Parameters, as written in a path file (`covtrace list` prints the same):
+//!
+//! <!-- parameters: generated from the specs (`COVTRACE_BLESS=1 cargo test --test param_tables`) -->
+//! | operator | parameter | unit | default | meaning |
 //! |---|---|---|---|---|
-//! | [`Moving`] | `velocity` | m/s | finite, `[vx]` or `[vx, vy]` | the object's velocity in the tangent plane |
-//! | [`Moving`] | `angular` | rad/s | finite, optional | the object's angular velocity (`u`, `v`) |
-//! | [`Moving`] | `operators` | | a list | the object's own static operators (windows, lobes, curvature …) |
-//! | [`CameraMotion`] | `velocity` | m/s | finite | the camera's velocity: enters its frame for the rest of the path |
-//! | [`Shutter`] | `duration` | s | > 0 | exposure time |
-//! | [`Shutter`] | `shape` | | `Box` or `Gaussian` | a box of length `duration` (moment-matched Gaussian of std `duration/√12`) or a Gaussian of std `duration` |
+//! | `Moving` | `velocity` | m/s | required | Velocity in the tangent plane, `[vx]` or `[vx, vy]`, finite. |
+//! |  | `angular` | rad/s | optional | Angular velocity, `[wu]` or `[wu, wv]`. |
+//! |  | `operators` | – | required | The object's static operators, applied in its moving frame. |
+//! | `CameraMotion` | `velocity` | m/s | required | Velocity of the camera, `[vx]` or `[vx, vy]`, finite. |
+//! |  | `angular` | rad/s | optional | Angular velocity of the camera, `[wu]` or `[wu, wv]`. |
+//! | `Shutter` | `duration` | s | required | Exposure, > 0. |
+//! |  | `shape` | – | optional | `Box` (default) or `Gaussian` (std = duration). |
+//! <!-- end of parameters -->
 //!
 //! All need the time axis (layouts 3 and 5). A zero-length shutter is rejected
 //! (`duration > 0`): its limit is a static image, traced without `t`.
@@ -30,16 +35,14 @@
 //! temporal detail. The shutter adds `1/(4π² (0.02/√12)²) ≈ 760 (cycles/s)²` to `Σ_tt`.
 //!
 //! ```
-//! use cov_core::{Axis, Cov, Operator};
+//! use cov_core::{Axis, Chain, Cov, Operator};
 //! use cov_motion::{Moving, Shutter, ShutterShape};
-//! use cov_path::DynOperator;
-//! use std::sync::Arc;
 //!
 //! let window = cov_occlusion::Window::isotropic(0.001)?; // a 1 mm Gaussian occluder
-//! let moving = Moving::new([2.0, 0.0], [0.0, 0.0], vec![DynOperator(Arc::new(window))])?;
+//! let moving = Moving::new([2.0, 0.0], [0.0, 0.0], Chain::new().with(window))?;
 //! let mut c = Cov::<3>::zeros();
-//! Operator::<3>::apply(&moving, &mut c)?;
-//! Operator::<3>::apply(&Shutter::new(0.02, ShutterShape::Box)?, &mut c)?;
+//! Operator::apply(&moving, &mut c)?;
+//! Operator::apply(&Shutter::new(0.02, ShutterShape::Box)?, &mut c)?;
 //! let w = 1.0 / (4.0 * std::f64::consts::PI.powi(2) * 1e-6);
 //! assert!((c.at(Axis::X, Axis::T)? + 2.0 * w).abs() < 1e-9 * w);
 //! # Ok::<(), cov_core::CovError>(())
@@ -69,8 +72,7 @@
 
 pub mod spec;
 
-use cov_core::{Axis, AxisSet, Cov, CovError, FOUR_PI_SQ, Operator, Spectrum};
-use cov_path::{DynOperator, Operators};
+use cov_core::{Axis, AxisSet, Chain, CovError, FOUR_PI_SQ, Operator, Spectrum};
 
 /// The frame of an object in motion: linear and angular velocity in the tangent plane.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -83,13 +85,21 @@ impl MotionFrame {
     /// # Errors
     /// Non-finite components.
     pub fn new(velocity: [f64; 2], angular: [f64; 2]) -> Result<Self, CovError> {
+        Self::for_operator("MotionFrame", velocity, angular)
+    }
+
+    /// As [`MotionFrame::new`], errors naming `operator`.
+    ///
+    /// # Errors
+    /// Non-finite components.
+    pub fn for_operator(operator: &str, velocity: [f64; 2], angular: [f64; 2]) -> Result<Self, CovError> {
         for (name, x) in [
             ("velocity.x", velocity[0]),
             ("velocity.y", velocity[1]),
             ("angular.u", angular[0]),
             ("angular.v", angular[1]),
         ] {
-            CovError::check_finite("Moving", name, x)?;
+            CovError::require_finite(operator, name, x)?;
         }
         Ok(MotionFrame {
             v: velocity,
@@ -111,14 +121,14 @@ impl MotionFrame {
     ///
     /// # Errors
     /// Missing time axis, overflow.
-    pub fn shear<const N: usize>(&self, cov: &mut dyn Spectrum<N>, sign: f64) -> Result<(), CovError> {
+    pub fn shear(&self, cov: &mut dyn Spectrum, sign: f64) -> Result<(), CovError> {
         let pairs = [
             (Axis::X, self.v[0]),
             (Axis::Y, self.v[1]),
             (Axis::U, self.w[0]),
             (Axis::V, self.w[1]),
         ];
-        Cov::<N>::index(Axis::T)?;
+        cov.index(Axis::T)?;
         for (axis, rate) in pairs {
             if rate != 0.0 {
                 cov.shear(axis, Axis::T, sign * rate)?;
@@ -132,7 +142,7 @@ impl MotionFrame {
 #[derive(Clone, Debug)]
 pub struct Moving {
     frame: MotionFrame,
-    operators: Operators,
+    operators: Chain,
 }
 
 impl Moving {
@@ -141,25 +151,22 @@ impl Moving {
 
     /// # Errors
     /// Non-finite velocities.
-    pub fn new(velocity: [f64; 2], angular: [f64; 2], operators: Vec<DynOperator>) -> Result<Self, CovError> {
+    pub fn new(velocity: [f64; 2], angular: [f64; 2], operators: Chain) -> Result<Self, CovError> {
         Ok(Moving {
-            frame: MotionFrame::new(velocity, angular)?,
-            operators: Operators(operators),
+            frame: MotionFrame::for_operator(Self::NAME, velocity, angular)?,
+            operators,
         })
     }
 }
 
-impl<const N: usize> Operator<N> for Moving {
-    fn apply(&self, cov: &mut dyn Spectrum<N>) -> Result<(), CovError> {
+impl Operator for Moving {
+    fn apply(&self, cov: &mut dyn Spectrum) -> Result<(), CovError> {
         self.frame.shear(cov, 1.0)?;
         self.operators.apply(cov)?;
         self.frame.shear(cov, -1.0)
     }
-    fn name(&self) -> &str {
-        Self::NAME
-    }
     fn requires(&self) -> AxisSet {
-        self.frame.requires().union(self.operators.requires())
+        self.frame.requires().union(self.operators.requires_all())
     }
 }
 
@@ -177,17 +184,14 @@ impl CameraMotion {
     /// Non-finite velocities.
     pub fn new(velocity: [f64; 2], angular: [f64; 2]) -> Result<Self, CovError> {
         Ok(CameraMotion {
-            frame: MotionFrame::new(velocity, angular)?,
+            frame: MotionFrame::for_operator(Self::NAME, velocity, angular)?,
         })
     }
 }
 
-impl<const N: usize> Operator<N> for CameraMotion {
-    fn apply(&self, cov: &mut dyn Spectrum<N>) -> Result<(), CovError> {
+impl Operator for CameraMotion {
+    fn apply(&self, cov: &mut dyn Spectrum) -> Result<(), CovError> {
         self.frame.shear(cov, 1.0)
-    }
-    fn name(&self) -> &str {
-        Self::NAME
     }
     fn requires(&self) -> AxisSet {
         self.frame.requires()
@@ -220,13 +224,13 @@ impl Shutter {
     /// Non-positive or non-finite duration (a zero-length shutter is a static image: trace
     /// without time instead).
     pub fn new(duration: f64, shape: ShutterShape) -> Result<Self, CovError> {
-        CovError::check_positive(Self::NAME, "duration", duration)?;
+        CovError::require_positive(Self::NAME, "duration", duration)?;
         let std = match shape {
             ShutterShape::Box => duration / 12f64.sqrt(),
             ShutterShape::Gaussian => duration,
         };
         let w = 1.0 / (FOUR_PI_SQ * std * std);
-        CovError::check_range(
+        CovError::require_range(
             Self::NAME,
             "duration",
             w,
@@ -242,12 +246,9 @@ impl Shutter {
     }
 }
 
-impl<const N: usize> Operator<N> for Shutter {
-    fn apply(&self, cov: &mut dyn Spectrum<N>) -> Result<(), CovError> {
+impl Operator for Shutter {
+    fn apply(&self, cov: &mut dyn Spectrum) -> Result<(), CovError> {
         cov.add_variance(Axis::T, self.w)
-    }
-    fn name(&self) -> &str {
-        Self::NAME
     }
     fn requires(&self) -> AxisSet {
         AxisSet::FLAT_TIME

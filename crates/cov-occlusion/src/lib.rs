@@ -5,12 +5,22 @@
 //! `Σ' = Σ + W`, `W` the spectrum covariance of `w`. Planar occluders act on the spatial
 //! axes only; a thick occluder is sliced along its depth, with travel between slices.
 //!
-//! | operator | parameter | unit | domain | meaning |
+//! Parameters, as written in a path file (`covtrace list` prints the same):
+//!
+//! <!-- parameters: generated from the specs (`COVTRACE_BLESS=1 cargo test --test param_tables`) -->
+//! | operator | parameter | unit | default | meaning |
 //! |---|---|---|---|---|
-//! | [`Window`] | `std_x`, `std_y` | m | > 0 | std of a Gaussian window across the ray (`std_y` unused in flatland) |
-//! | [`BlockerEdge`] | `distance` | m | > 0 | distance from the ray to the nearest blocker edge (the largest unoccluded disk's radius) |
-//! | [`Texture`] | `sxx`, `sxy`, `syy` | (cycles/m)² | PSD | spectrum covariance of the texture's variation around the hit point |
-//! | [`ThickOccluder`] | `depth`, `slices`, `std` | m, count, m | ≥ 0, ≥ 1, > 0 | an occluder `depth` deep, as `slices` windows of std `std` with travel `depth/slices` after each |
+//! | `Window` | `std_x` | m | required | Std along x, > 0. |
+//! |  | `std_y` | m | optional | Std along y, > 0 (`std_x` when left out). |
+//! | `BlockerEdge` | `distance` | m | required | Distance from the ray to the nearest blocker edge, > 0. |
+//! | `Texture` | `feature` | m | optional | Size of the texture's features (a Gaussian bump of that std), > 0; or give the spectrum `sxx`, `sxy`, `syy`. |
+//! |  | `sxx` | (cycles/m)² | optional | Spectrum covariance xx, ≥ 0. |
+//! |  | `sxy` | (cycles/m)² | optional | Spectrum covariance xy, `\|sxy\| ≤ √(sxx·syy)` (0 when left out). |
+//! |  | `syy` | (cycles/m)² | optional | Spectrum covariance yy, ≥ 0 (`sxx` when left out). |
+//! | `ThickOccluder` | `depth` | m | required | Depth of the occluder along the ray, ≥ 0. |
+//! |  | `slices` | – | required | Number of slices, ≥ 1. |
+//! |  | `std` | m | required | Window std of each slice, > 0. |
+//! <!-- end of parameters -->
 //!
 //! The **blocker-edge rule** (the course's "largest unoccluded disk"): the local window
 //! shrinks until no blocker is near-hit or near-missed, so a blocker edge at distance `r`
@@ -23,7 +33,7 @@
 //! use cov_occlusion::BlockerEdge;
 //!
 //! let mut c = Cov::<2>::zeros(); // uniform light
-//! Operator::<2>::apply(&BlockerEdge::new(0.01)?, &mut c)?; // blocker 1 cm away
+//! Operator::apply(&BlockerEdge::new(0.01)?, &mut c)?; // blocker 1 cm away
 //! assert!((c.get(0, 0) - 1.0 / (4.0 * std::f64::consts::PI.powi(2) * 1e-4)).abs() < 1e-9);
 //! # Ok::<(), cov_core::CovError>(())
 //! ```
@@ -54,12 +64,12 @@
 
 pub mod spec;
 
-use cov_core::{Axis, Cov, CovError, FOUR_PI_SQ, Operator, Spectrum};
+use cov_core::{Axis, CovError, FOUR_PI_SQ, Operator, Spectrum};
 
 fn window_var(op: &str, name: &str, std: f64) -> Result<f64, CovError> {
-    CovError::check_positive(op, name, std)?;
+    CovError::require_positive(op, name, std)?;
     let w = 1.0 / (FOUR_PI_SQ * std * std);
-    CovError::check_range(op, name, w, f64::is_finite, "too small: 1/(4π² s²) overflows")?;
+    CovError::require_range(op, name, w, f64::is_finite, "too small: 1/(4π² s²) overflows")?;
     Ok(w)
 }
 
@@ -94,16 +104,13 @@ impl Window {
     }
 }
 
-impl<const N: usize> Operator<N> for Window {
-    fn apply(&self, cov: &mut dyn Spectrum<N>) -> Result<(), CovError> {
+impl Operator for Window {
+    fn apply(&self, cov: &mut dyn Spectrum) -> Result<(), CovError> {
         cov.add_variance(Axis::X, self.wx)?;
-        if Cov::<N>::has(Axis::Y) {
+        if cov.has(Axis::Y) {
             cov.add_variance(Axis::Y, self.wy)?;
         }
         Ok(())
-    }
-    fn name(&self) -> &str {
-        Self::NAME
     }
 }
 
@@ -135,12 +142,9 @@ impl BlockerEdge {
     }
 }
 
-impl<const N: usize> Operator<N> for BlockerEdge {
-    fn apply(&self, cov: &mut dyn Spectrum<N>) -> Result<(), CovError> {
-        Operator::<N>::apply(&self.window, cov)
-    }
-    fn name(&self) -> &str {
-        Self::NAME
+impl Operator for BlockerEdge {
+    fn apply(&self, cov: &mut dyn Spectrum) -> Result<(), CovError> {
+        Operator::apply(&self.window, cov)
     }
 }
 
@@ -160,9 +164,9 @@ impl Texture {
     /// # Errors
     /// Non-finite entries, or a matrix that is not PSD.
     pub fn new(sxx: f64, sxy: f64, syy: f64) -> Result<Self, CovError> {
-        CovError::check_non_negative(Self::NAME, "sxx", sxx)?;
-        CovError::check_non_negative(Self::NAME, "syy", syy)?;
-        CovError::check_finite(Self::NAME, "sxy", sxy)?;
+        CovError::require_non_negative(Self::NAME, "sxx", sxx)?;
+        CovError::require_non_negative(Self::NAME, "syy", syy)?;
+        CovError::require_finite(Self::NAME, "sxy", sxy)?;
         if sxy * sxy > sxx * syy * (1.0 + 1e-12) {
             return Err(CovError::OutOfRange {
                 operator: Self::NAME.into(),
@@ -184,16 +188,13 @@ impl Texture {
     }
 }
 
-impl<const N: usize> Operator<N> for Texture {
-    fn apply(&self, cov: &mut dyn Spectrum<N>) -> Result<(), CovError> {
-        if Cov::<N>::has(Axis::Y) {
+impl Operator for Texture {
+    fn apply(&self, cov: &mut dyn Spectrum) -> Result<(), CovError> {
+        if cov.has(Axis::Y) {
             cov.add_window(&[Axis::X, Axis::Y], &[self.s[0], self.s[1], self.s[1], self.s[2]])
         } else {
             cov.add_variance(Axis::X, self.s[0])
         }
-    }
-    fn name(&self) -> &str {
-        Self::NAME
     }
 }
 
@@ -213,7 +214,7 @@ impl ThickOccluder {
     /// # Errors
     /// Negative or non-finite `depth`, `slices == 0`, invalid `std`.
     pub fn new(depth: f64, slices: u32, std: f64) -> Result<Self, CovError> {
-        CovError::check_non_negative(Self::NAME, "depth", depth)?;
+        CovError::require_non_negative(Self::NAME, "depth", depth)?;
         if slices == 0 {
             return Err(CovError::OutOfRange {
                 operator: Self::NAME.into(),
@@ -231,17 +232,14 @@ impl ThickOccluder {
     }
 }
 
-impl<const N: usize> Operator<N> for ThickOccluder {
-    fn apply(&self, cov: &mut dyn Spectrum<N>) -> Result<(), CovError> {
+impl Operator for ThickOccluder {
+    fn apply(&self, cov: &mut dyn Spectrum) -> Result<(), CovError> {
         for _ in 0..self.slices {
-            Operator::<N>::apply(&self.window, cov)?;
-            for &(p, d) in Cov::<N>::transverse_pairs() {
+            Operator::apply(&self.window, cov)?;
+            for &(p, d) in cov.transverse_pairs() {
                 cov.shear(p, d, -self.step)?;
             }
         }
         Ok(())
-    }
-    fn name(&self) -> &str {
-        Self::NAME
     }
 }

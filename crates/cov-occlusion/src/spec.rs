@@ -1,113 +1,69 @@
 //! RON parameters of the occlusion operators.
 
 use cov_core::CovError;
-use cov_path::{OperatorSpec, Param, Registry};
-use serde::Deserialize;
+use cov_core::{OperatorSpec, Registrar};
 
 use crate::{BlockerEdge, Texture, ThickOccluder, Window};
 
 /// `Window(std_x: 0.1)` or `Window(std_x: 0.1, std_y: 0.2)`.
-#[derive(Debug, Deserialize)]
-#[serde(deny_unknown_fields)]
+#[derive(Debug, OperatorSpec)]
+#[operator(summary = "Gaussian window across the ray (an occluder's aperture)")]
 pub struct WindowSpec {
-    /// Std along x (m).
+    /// Std along x, > 0.
+    #[param(unit = "m")]
     pub std_x: f64,
-    /// Std along y (m); defaults to `std_x`.
-    #[serde(default)]
+    /// Std along y, > 0 (`std_x` when left out).
+    #[param(unit = "m", default)]
     pub std_y: Option<f64>,
 }
 
-impl OperatorSpec for WindowSpec {
-    const NAME: &'static str = Window::NAME;
-    const SUMMARY: &'static str = "Gaussian window across the ray (an occluder's aperture)";
-    const PARAMS: &'static [Param] = &[
-        Param {
-            name: "std_x",
-            unit: "m",
-            doc: "> 0",
-        },
-        Param {
-            name: "std_y",
-            unit: "m",
-            doc: "> 0, optional (default std_x)",
-        },
-    ];
-    type Op = Window;
-    fn build(self) -> Result<Window, CovError> {
-        Window::new(self.std_x, self.std_y.unwrap_or(self.std_x))
+impl TryFrom<WindowSpec> for Window {
+    type Error = CovError;
+    fn try_from(spec: WindowSpec) -> Result<Window, CovError> {
+        Window::new(spec.std_x, spec.std_y.unwrap_or(spec.std_x))
     }
 }
 
 /// `BlockerEdge(distance: 0.02)`.
-#[derive(Debug, Deserialize)]
-#[serde(deny_unknown_fields)]
+#[derive(Debug, OperatorSpec)]
+#[operator(summary = "blocker edge near the ray (largest unoccluded disk rule)")]
 pub struct BlockerEdgeSpec {
-    /// Distance from the ray to the nearest blocker edge (m).
+    /// Distance from the ray to the nearest blocker edge, > 0.
+    #[param(unit = "m")]
     pub distance: f64,
 }
 
-impl OperatorSpec for BlockerEdgeSpec {
-    const NAME: &'static str = BlockerEdge::NAME;
-    const SUMMARY: &'static str = "blocker edge near the ray (largest unoccluded disk rule)";
-    const PARAMS: &'static [Param] = &[Param {
-        name: "distance",
-        unit: "m",
-        doc: "> 0",
-    }];
-    type Op = BlockerEdge;
-    fn build(self) -> Result<BlockerEdge, CovError> {
-        BlockerEdge::new(self.distance)
+impl TryFrom<BlockerEdgeSpec> for BlockerEdge {
+    type Error = CovError;
+    fn try_from(spec: BlockerEdgeSpec) -> Result<BlockerEdge, CovError> {
+        BlockerEdge::new(spec.distance)
     }
 }
 
 /// `Texture(feature: 0.01)` or `Texture(sxx: 100, sxy: 0, syy: 50)`.
-#[derive(Debug, Deserialize)]
-#[serde(deny_unknown_fields)]
+#[derive(Debug, OperatorSpec)]
+#[operator(summary = "texture variation as a window on position")]
 pub struct TextureSpec {
-    /// Size of the texture's features (m): a Gaussian bump of that std.
-    #[serde(default)]
+    /// Size of the texture's features (a Gaussian bump of that std), > 0; or give the spectrum `sxx`, `sxy`, `syy`.
+    #[param(unit = "m", default)]
     pub feature: Option<f64>,
-    /// Spectrum covariance xx ((cycles/m)²).
-    #[serde(default)]
+    /// Spectrum covariance xx, ≥ 0.
+    #[param(unit = "(cycles/m)²", default)]
     pub sxx: Option<f64>,
-    /// Spectrum covariance xy.
-    #[serde(default)]
+    /// Spectrum covariance xy, `|sxy| ≤ √(sxx·syy)` (0 when left out).
+    #[param(unit = "(cycles/m)²", default)]
     pub sxy: Option<f64>,
-    /// Spectrum covariance yy.
-    #[serde(default)]
+    /// Spectrum covariance yy, ≥ 0 (`sxx` when left out).
+    #[param(unit = "(cycles/m)²", default)]
     pub syy: Option<f64>,
 }
 
-impl OperatorSpec for TextureSpec {
-    const NAME: &'static str = "Texture";
-    const SUMMARY: &'static str = "texture variation as a window on position";
-    const PARAMS: &'static [Param] = &[
-        Param {
-            name: "feature",
-            unit: "m",
-            doc: "> 0; or give the spectrum below",
-        },
-        Param {
-            name: "sxx",
-            unit: "(cycles/m)²",
-            doc: "≥ 0",
-        },
-        Param {
-            name: "sxy",
-            unit: "(cycles/m)²",
-            doc: "|sxy| ≤ √(sxx·syy), default 0",
-        },
-        Param {
-            name: "syy",
-            unit: "(cycles/m)²",
-            doc: "≥ 0, default sxx",
-        },
-    ];
-    type Op = Texture;
-    fn build(self) -> Result<Texture, CovError> {
-        match (self.feature, self.sxx) {
-            (Some(f), None) if self.sxy.is_none() && self.syy.is_none() => Texture::gaussian_feature(f),
-            (None, Some(sxx)) => Texture::new(sxx, self.sxy.unwrap_or(0.0), self.syy.unwrap_or(sxx)),
+impl TryFrom<TextureSpec> for Texture {
+    type Error = CovError;
+    fn try_from(spec: TextureSpec) -> Result<Texture, CovError> {
+        match (spec.feature, spec.sxx) {
+            (Some(f), None) if spec.sxy.is_none() && spec.syy.is_none() => Texture::gaussian_feature(f),
+            (None, Some(sxx)) => Texture::new(sxx, spec.sxy.unwrap_or(0.0), spec.syy.unwrap_or(sxx)),
             _ => Err(CovError::OutOfRange {
                 operator: "Texture".into(),
                 parameter: "feature / sxx".into(),
@@ -119,47 +75,30 @@ impl OperatorSpec for TextureSpec {
 }
 
 /// `ThickOccluder(depth: 0.3, slices: 4, std: 0.05)`.
-#[derive(Debug, Deserialize)]
-#[serde(deny_unknown_fields)]
+#[derive(Debug, OperatorSpec)]
+#[operator(summary = "an occluder with depth, as slices of windows with travel between")]
 pub struct ThickOccluderSpec {
-    /// Depth of the occluder along the ray (m).
+    /// Depth of the occluder along the ray, ≥ 0.
+    #[param(unit = "m")]
     pub depth: f64,
-    /// Number of slices.
+    /// Number of slices, ≥ 1.
     pub slices: u32,
-    /// Window std of each slice (m).
+    /// Window std of each slice, > 0.
+    #[param(unit = "m")]
     pub std: f64,
 }
 
-impl OperatorSpec for ThickOccluderSpec {
-    const NAME: &'static str = ThickOccluder::NAME;
-    const SUMMARY: &'static str = "an occluder with depth, as slices of windows with travel between";
-    const PARAMS: &'static [Param] = &[
-        Param {
-            name: "depth",
-            unit: "m",
-            doc: "≥ 0",
-        },
-        Param {
-            name: "slices",
-            unit: "–",
-            doc: "≥ 1",
-        },
-        Param {
-            name: "std",
-            unit: "m",
-            doc: "> 0",
-        },
-    ];
-    type Op = ThickOccluder;
-    fn build(self) -> Result<ThickOccluder, CovError> {
-        ThickOccluder::new(self.depth, self.slices, self.std)
+impl TryFrom<ThickOccluderSpec> for ThickOccluder {
+    type Error = CovError;
+    fn try_from(spec: ThickOccluderSpec) -> Result<ThickOccluder, CovError> {
+        ThickOccluder::new(spec.depth, spec.slices, spec.std)
     }
 }
 
 /// Registers this crate's operators.
-pub fn register(r: &mut Registry) {
-    r.register::<WindowSpec>()
-        .register::<BlockerEdgeSpec>()
-        .register::<TextureSpec>()
-        .register::<ThickOccluderSpec>();
+pub fn register<R: Registrar>(r: &mut R) {
+    r.add::<WindowSpec>()
+        .add::<BlockerEdgeSpec>()
+        .add::<TextureSpec>()
+        .add::<ThickOccluderSpec>();
 }

@@ -1,5 +1,6 @@
 //! Occlusion operators against the ground truth; the hard edge measures its error.
 
+use cov_core::Spectrum;
 use std::sync::Arc;
 
 use cov_core::{Cov, FOUR_PI_SQ, Operator};
@@ -13,13 +14,13 @@ fn gaussian_window_and_texture_match_ground_truth() {
     p.shear(cov_core::Axis::X, cov_core::Axis::U, -1.0).unwrap();
     let base = Field::gaussian(&stds).then(Primal::travel(2, 1.0));
     let mut w = p;
-    Operator::<2>::apply(&Window::isotropic(0.1).unwrap(), &mut w).unwrap();
+    Operator::apply(&Window::isotropic(0.1).unwrap(), &mut w).unwrap();
     let f = base.clone().then(Primal::gaussian_window(0, 0.1));
     let r = compare(&f, &w, &Grid::auto(&w, 64, &[1.0; 2])).unwrap();
     assert!(r.rel_error < 1e-3, "window: {:e}", r.rel_error);
 
     let mut t = p;
-    Operator::<2>::apply(&Texture::gaussian_feature(0.02).unwrap(), &mut t).unwrap();
+    Operator::apply(&Texture::gaussian_feature(0.02).unwrap(), &mut t).unwrap();
     let f = base.then(Primal::gaussian_window(0, 0.02));
     let r = compare(&f, &t, &Grid::auto(&t, 64, &[1.0; 2])).unwrap();
     assert!(r.rel_error < 1e-3, "texture: {:e}", r.rel_error);
@@ -34,7 +35,7 @@ fn anisotropic_texture_in_4d() {
     let tex = Texture::new(ixx / FOUR_PI_SQ, ixy / FOUR_PI_SQ, iyy / FOUR_PI_SQ).unwrap();
     let stds = [0.5, 0.4, 0.2, 0.3];
     let mut p = Cov::<4>::gaussian(stds).unwrap();
-    Operator::<4>::apply(&tex, &mut p).unwrap();
+    Operator::apply(&tex, &mut p).unwrap();
     let f = Field::gaussian(&stds).then(Primal::Window(Arc::new(move |z: &[f64]| {
         (-0.5 * (ixx * z[0] * z[0] + 2.0 * ixy * z[0] * z[1] + iyy * z[1] * z[1])).exp()
     })));
@@ -46,7 +47,7 @@ fn anisotropic_texture_in_4d() {
 fn thick_occluder_matches_sliced_ground_truth() {
     let stds = [0.2, 0.1];
     let mut p = Cov::<2>::gaussian(stds).unwrap();
-    Operator::<2>::apply(&ThickOccluder::new(0.4, 4, 0.15).unwrap(), &mut p).unwrap();
+    Operator::apply(&ThickOccluder::new(0.4, 4, 0.15).unwrap(), &mut p).unwrap();
     let mut f = Field::gaussian(&stds);
     for _ in 0..4 {
         f = f
@@ -66,7 +67,7 @@ fn hard_blocker_edge_approximation_error() {
     let r_edge = 0.05;
     let stds = [0.5, f64::INFINITY];
     let mut p = Cov::<2>::gaussian(stds).unwrap();
-    Operator::<2>::apply(&BlockerEdge::new(r_edge).unwrap(), &mut p).unwrap();
+    Operator::apply(&BlockerEdge::new(r_edge).unwrap(), &mut p).unwrap();
     let f = Field::gaussian(&stds).then(Primal::Window(Arc::new(
         move |z: &[f64]| if z[0] > -r_edge { 1.0 } else { 0.0 },
     )));

@@ -13,7 +13,7 @@
 //!     source: Gaussian(x: 0.1, y: 0.1),   // primal std per axis; others constant
 //!     operators: [
 //!         Travel(distance: 1.0),
-//!         Reflect(cos_in: 0.8, cos_out: 0.8, curvature: Isotropic(k: 2.0), lobe: Phong(exponent: 200)),
+//!         Reflect(cos_in: 0.8, cos_out: 0.8, curvature: (kx: 2.0, ky: 2.0), lobe: Phong(exponent: 200)),
 //!         Travel(distance: 2.0),
 //!     ],
 //! )
@@ -26,11 +26,16 @@
 
 #![warn(missing_docs)]
 
-mod nested;
+mod de;
+mod error;
+mod eval;
 mod path;
 mod registry;
 mod scan;
+mod source;
 
-pub use nested::Operators;
-pub use path::{EvalStep, Evaluation, Path, PathError, Source, ron_options};
-pub use registry::{DynOperator, Entry, OperatorSpec, Param, PathOperator, Registry};
+pub use error::PathError;
+pub use eval::{EvalStep, Evaluation, StepReport};
+pub use path::{Path, ron_options};
+pub use registry::{Entry, Registry};
+pub use source::Source;

@@ -1,82 +1,78 @@
-//! Where each operator of a path file starts: a light scan of the `operators` list that
-//! skips comments and strings. Used to give evaluation errors (which happen after ron has
-//! finished) the line and column of the failing step.
+//! A light scan of a path file for its operator lists (the value of every `operators:`
+//! key, nested ones included), skipping comments and strings. It gives evaluation errors
+//! (which happen after ron has finished) the line and column of the failing step, and
+//! tells the parser which operators are written as a bare name (`Mirror`) rather than
+//! with parentheses (`Mirror()`), in the order ron meets them.
 
-/// Line and column (1-based) of each element of the top-level `operators: [...]` list.
-/// Returns an empty list if the text does not have the expected shape.
-pub(crate) fn operator_positions(text: &str) -> Vec<(usize, usize)> {
+/// One element of an operator list.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) struct Element {
+    /// 1-based line.
+    pub line: usize,
+    /// 1-based column (in characters).
+    pub col: usize,
+    /// Whether it is in the path's own (top-level) list.
+    pub top: bool,
+    /// Whether its name is not followed by `(`.
+    pub bare: bool,
+}
+
+/// Every element of every operator list, in the order of the text.
+pub(crate) fn operator_elements(text: &str) -> Vec<Element> {
     let chars: Vec<char> = text.chars().collect();
+    let mut pos = Vec::with_capacity(chars.len());
     let (mut line, mut col) = (1usize, 1usize);
-    let mut depth = 0usize;
-    let mut i = 0;
-    let mut ident = String::new();
-    let mut last_ident = String::new();
-    let mut list_depth: Option<usize> = None;
-    let mut expect_element = false;
-    let mut out = Vec::new();
-    let advance = |c: char, line: &mut usize, col: &mut usize| {
+    for &c in &chars {
+        pos.push((line, col));
         if c == '\n' {
-            *line += 1;
-            *col = 1;
+            line += 1;
+            col = 1;
         } else {
-            *col += 1;
+            col += 1;
         }
-    };
+    }
+    // Stack of open brackets: true for an operator list.
+    let mut stack: Vec<bool> = Vec::new();
+    let mut out = Vec::new();
+    let mut last_ident = String::new();
+    let mut ident = String::new();
+    let mut expect_element = false;
+    let mut i = 0;
     while i < chars.len() {
         let c = chars[i];
-        // Comments.
-        if c == '/' && chars.get(i + 1) == Some(&'/') {
-            while i < chars.len() && chars[i] != '\n' {
-                advance(chars[i], &mut line, &mut col);
-                i += 1;
-            }
+        if let Some(next) = skip_comment(&chars, i) {
+            i = next;
             continue;
         }
-        if c == '/' && chars.get(i + 1) == Some(&'*') {
-            let mut nest = 0;
-            while i < chars.len() {
-                if chars[i] == '/' && chars.get(i + 1) == Some(&'*') {
-                    nest += 1;
-                    advance(chars[i], &mut line, &mut col);
-                    i += 1;
-                } else if chars[i] == '*' && chars.get(i + 1) == Some(&'/') {
-                    nest -= 1;
-                    advance(chars[i], &mut line, &mut col);
-                    i += 1;
-                    if nest == 0 {
-                        advance(chars[i], &mut line, &mut col);
-                        i += 1;
-                        break;
-                    }
-                }
-                advance(chars[i], &mut line, &mut col);
-                i += 1;
-            }
-            continue;
-        }
-        if expect_element && !c.is_whitespace() && c != ']' {
-            out.push((line, col));
-            expect_element = false;
-        }
-        // Strings.
         if c == '"' {
-            advance(c, &mut line, &mut col);
-            i += 1;
-            while i < chars.len() && chars[i] != '"' {
-                if chars[i] == '\\' {
-                    advance(chars[i], &mut line, &mut col);
-                    i += 1;
-                }
-                if i < chars.len() {
-                    advance(chars[i], &mut line, &mut col);
-                    i += 1;
-                }
-            }
-            if i < chars.len() {
-                advance(chars[i], &mut line, &mut col);
-                i += 1;
-            }
+            i = skip_string(&chars, i);
             continue;
+        }
+        let in_list = stack.last() == Some(&true);
+        if expect_element && in_list && !c.is_whitespace() && c != ']' {
+            expect_element = false;
+            let (line, col) = pos[i];
+            // The name, then whatever follows it.
+            let mut j = i;
+            while j < chars.len() && (chars[j].is_alphanumeric() || chars[j] == '_') {
+                j += 1;
+            }
+            let mut k = j;
+            loop {
+                while k < chars.len() && chars[k].is_whitespace() {
+                    k += 1;
+                }
+                match skip_comment(&chars, k) {
+                    Some(next) => k = next,
+                    None => break,
+                }
+            }
+            out.push(Element {
+                line,
+                col,
+                top: stack.iter().filter(|&&b| b).count() == 1,
+                bare: j > i && chars.get(k) != Some(&'('),
+            });
         }
         if c.is_alphanumeric() || c == '_' {
             ident.push(c);
@@ -84,27 +80,81 @@ pub(crate) fn operator_positions(text: &str) -> Vec<(usize, usize)> {
             last_ident = std::mem::take(&mut ident);
         }
         match c {
-            '(' | '{' => depth += 1,
+            '(' | '{' => stack.push(false),
             '[' => {
-                depth += 1;
-                if list_depth.is_none() && depth == 2 && last_ident == "operators" {
-                    list_depth = Some(depth);
-                    expect_element = true;
-                }
+                let list = last_ident == "operators";
+                stack.push(list);
+                expect_element = list;
             }
             ')' | '}' | ']' => {
-                if list_depth == Some(depth) && c == ']' {
-                    return out;
-                }
-                depth = depth.saturating_sub(1);
+                stack.pop();
             }
-            ',' if list_depth == Some(depth) => expect_element = true,
+            ',' if in_list => expect_element = true,
             _ => {}
         }
-        advance(c, &mut line, &mut col);
+        if !(c.is_alphanumeric() || c == '_' || c.is_whitespace() || c == ':') {
+            last_ident.clear();
+        }
         i += 1;
     }
-    Vec::new()
+    out
+}
+
+/// Line and column of each element of the top-level `operators: [...]` list.
+pub(crate) fn operator_positions(text: &str) -> Vec<(usize, usize)> {
+    operator_elements(text)
+        .into_iter()
+        .filter(|e| e.top)
+        .map(|e| (e.line, e.col))
+        .collect()
+}
+
+/// The index after a comment starting at `i`, if one does.
+fn skip_comment(chars: &[char], i: usize) -> Option<usize> {
+    if chars.get(i) != Some(&'/') {
+        return None;
+    }
+    match chars.get(i + 1) {
+        Some('/') => {
+            let mut j = i;
+            while j < chars.len() && chars[j] != '\n' {
+                j += 1;
+            }
+            Some(j)
+        }
+        Some('*') => {
+            let mut nest = 0usize;
+            let mut j = i;
+            while j < chars.len() {
+                if chars[j] == '/' && chars.get(j + 1) == Some(&'*') {
+                    nest += 1;
+                    j += 2;
+                } else if chars[j] == '*' && chars.get(j + 1) == Some(&'/') {
+                    nest -= 1;
+                    j += 2;
+                    if nest == 0 {
+                        return Some(j);
+                    }
+                } else {
+                    j += 1;
+                }
+            }
+            Some(j)
+        }
+        _ => None,
+    }
+}
+
+/// The index after a string starting at `i` (a `"`).
+fn skip_string(chars: &[char], i: usize) -> usize {
+    let mut j = i + 1;
+    while j < chars.len() && chars[j] != '"' {
+        if chars[j] == '\\' {
+            j += 1;
+        }
+        j += 1;
+    }
+    j + 1
 }
 
 #[cfg(test)]
@@ -118,5 +168,16 @@ mod tests {
         assert!(operator_positions("Path(source: X)").is_empty());
         let t = "Path(\n    source: Matrix(rows: [[1e300, 0.0], [0.0, 1e300]]),\n    operators: [Curvature(k: 1e10)],\n)\n";
         assert_eq!(operator_positions(t), vec![(3, 17)]);
+    }
+
+    #[test]
+    fn finds_nested_and_bare_operators() {
+        let t = "Path(source: X, operators: [Mirror, Moving(velocity: [1], operators: [Diffuse /* c */ (), Mirror]), Travel(distance: 1)])";
+        let e = operator_elements(t);
+        let bare: Vec<bool> = e.iter().map(|e| e.bare).collect();
+        let top: Vec<bool> = e.iter().map(|e| e.top).collect();
+        assert_eq!(bare, vec![true, false, false, true, false]);
+        assert_eq!(top, vec![true, true, false, false, true]);
+        assert_eq!(operator_positions(t).len(), 3);
     }
 }

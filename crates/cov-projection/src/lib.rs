@@ -13,14 +13,18 @@
 //! Grazing incidence (`c → 0`) is a limit, not an error, as long as `c > 0`: the result
 //! stays finite and PSD (`c = 1e-12` is part of the tests).
 //!
-//! | operator | parameter | unit | domain | meaning |
+//! Parameters, as written in a path file (`covtrace list` prints the same):
+//!
+//! <!-- parameters: generated from the specs (`COVTRACE_BLESS=1 cargo test --test param_tables`) -->
+//! | operator | parameter | unit | default | meaning |
 //! |---|---|---|---|---|
-//! | [`Project`] | `cos` | – | (0, 1] | `|cos θ|` between the ray and the normal |
-//! | [`Project`] | `angle` | rad | finite | frame rotation applied first, aligning `x` with the plane of incidence (3D; must be 0 in flatland) |
-//! | [`Unproject`] | `cos` | – | (0, 1] | `|cos θ_out|` of the outgoing ray |
-//! | [`Unproject`] | `angle` | rad | finite | frame rotation applied last (3D; 0 in flatland) |
-//! | [`Mirror`] | – | | | |
-//! | [`RotateFrame`] | `angle` | rad | finite | |
+//! | `Project` | `cos` | – | required | `\|cos θ\|`, in (0, 1]. |
+//! |  | `angle` | rad | optional | Frame rotation applied first (3D). |
+//! | `Unproject` | `cos` | – | required | `\|cos θ_out\|`, in (0, 1]. |
+//! |  | `angle` | rad | optional | Frame rotation applied last (3D). |
+//! | `Mirror` | – | | | mirror symmetry of directions, l(x, −u) (no parameters) |
+//! | `RotateFrame` | `angle` | rad | required | Angle, finite, counter-clockwise x → y. |
+//! <!-- end of parameters -->
 //!
 //! [`Project::from_vectors`] computes `cos` and `angle` from the ray direction, the
 //! ray frame's `x` axis and the surface normal (glam `DVec3`).
@@ -31,9 +35,9 @@
 //!
 //! let mut c = Cov::<2>::gaussian([0.01, 0.1])?;
 //! let before = c.get(0, 0);
-//! Operator::<2>::apply(&Project::new(0.5)?, &mut c)?;
+//! Operator::apply(&Project::new(0.5)?, &mut c)?;
 //! assert!((c.get(0, 0) - 0.25 * before).abs() < 1e-12 * before);
-//! Operator::<2>::apply(&Unproject::new(0.5)?, &mut c)?; // back to the same angle
+//! Operator::apply(&Unproject::new(0.5)?, &mut c)?; // back to the same angle
 //! assert!((c.get(0, 0) - before).abs() < 1e-12 * before);
 //! # Ok::<(), cov_core::CovError>(())
 //! ```
@@ -59,14 +63,14 @@
 
 pub mod spec;
 
-use cov_core::{Axis, AxisSet, Cov, CovError, Operator, Spectrum};
+use cov_core::{Axis, AxisSet, CovError, Operator, Spectrum};
 use glam::DVec3;
 
 fn check_cos(op: &str, c: f64) -> Result<f64, CovError> {
-    CovError::check_range(op, "cos", c, |c| c > 0.0 && c <= 1.0, "must be in (0, 1]")
+    CovError::require_range(op, "cos", c, |c| c > 0.0 && c <= 1.0, "must be in (0, 1]")
 }
 
-fn rotate<const N: usize>(cov: &mut dyn Spectrum<N>, angle: f64) -> Result<(), CovError> {
+fn rotate(cov: &mut dyn Spectrum, angle: f64) -> Result<(), CovError> {
     if angle != 0.0 {
         cov.rotate_frame(angle)
     } else {
@@ -108,7 +112,7 @@ impl Project {
     pub fn with_angle(cos: f64, angle: f64) -> Result<Self, CovError> {
         Ok(Project {
             cos: check_cos(Self::NAME, cos)?,
-            angle: CovError::check_finite(Self::NAME, "angle", angle)?,
+            angle: CovError::require_finite(Self::NAME, "angle", angle)?,
         })
     }
 
@@ -161,13 +165,10 @@ impl Project {
     }
 }
 
-impl<const N: usize> Operator<N> for Project {
-    fn apply(&self, cov: &mut dyn Spectrum<N>) -> Result<(), CovError> {
+impl Operator for Project {
+    fn apply(&self, cov: &mut dyn Spectrum) -> Result<(), CovError> {
         rotate(cov, self.angle)?;
         cov.scale(Axis::X, self.cos)
-    }
-    fn name(&self) -> &str {
-        Self::NAME
     }
     fn requires(&self) -> AxisSet {
         needs(self.angle)
@@ -203,18 +204,15 @@ impl Unproject {
     pub fn with_angle(cos: f64, angle: f64) -> Result<Self, CovError> {
         Ok(Unproject {
             cos: check_cos(Self::NAME, cos)?,
-            angle: CovError::check_finite(Self::NAME, "angle", angle)?,
+            angle: CovError::require_finite(Self::NAME, "angle", angle)?,
         })
     }
 }
 
-impl<const N: usize> Operator<N> for Unproject {
-    fn apply(&self, cov: &mut dyn Spectrum<N>) -> Result<(), CovError> {
+impl Operator for Unproject {
+    fn apply(&self, cov: &mut dyn Spectrum) -> Result<(), CovError> {
         cov.scale(Axis::X, 1.0 / self.cos)?;
         rotate(cov, self.angle)
-    }
-    fn name(&self) -> &str {
-        Self::NAME
     }
     fn requires(&self) -> AxisSet {
         needs(self.angle)
@@ -230,15 +228,12 @@ impl Mirror {
     pub const NAME: &'static str = "Mirror";
 }
 
-impl<const N: usize> Operator<N> for Mirror {
-    fn apply(&self, cov: &mut dyn Spectrum<N>) -> Result<(), CovError> {
-        for &a in Cov::<N>::direction_axes() {
+impl Operator for Mirror {
+    fn apply(&self, cov: &mut dyn Spectrum) -> Result<(), CovError> {
+        for &a in cov.direction_axes() {
             cov.scale(a, -1.0)?;
         }
         Ok(())
-    }
-    fn name(&self) -> &str {
-        Self::NAME
     }
 }
 
@@ -256,17 +251,14 @@ impl RotateFrame {
     /// Non-finite `angle`.
     pub fn new(angle: f64) -> Result<Self, CovError> {
         Ok(RotateFrame {
-            angle: CovError::check_finite(Self::NAME, "angle", angle)?,
+            angle: CovError::require_finite(Self::NAME, "angle", angle)?,
         })
     }
 }
 
-impl<const N: usize> Operator<N> for RotateFrame {
-    fn apply(&self, cov: &mut dyn Spectrum<N>) -> Result<(), CovError> {
+impl Operator for RotateFrame {
+    fn apply(&self, cov: &mut dyn Spectrum) -> Result<(), CovError> {
         cov.rotate_frame(self.angle)
-    }
-    fn name(&self) -> &str {
-        Self::NAME
     }
     fn requires(&self) -> AxisSet {
         AxisSet::SPACE

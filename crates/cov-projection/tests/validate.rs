@@ -1,5 +1,6 @@
 //! Projection, mirror and frame rotation against the ground truth and geometry.
 
+use cov_core::Spectrum;
 use cov_core::{Cov, Operator};
 use cov_projection::{Mirror, Project, RotateFrame, Unproject};
 use cov_validate::{Field, Grid, Primal, compare};
@@ -15,15 +16,15 @@ fn projection_chain_matches_ground_truth_2d() {
         let mut q = p;
         let f = match op {
             0 => {
-                Operator::<2>::apply(&Project::new(0.3).unwrap(), &mut q).unwrap();
+                Operator::apply(&Project::new(0.3).unwrap(), &mut q).unwrap();
                 base.clone().then(Primal::scale(2, 0, 0.3))
             }
             1 => {
-                Operator::<2>::apply(&Unproject::new(0.6).unwrap(), &mut q).unwrap();
+                Operator::apply(&Unproject::new(0.6).unwrap(), &mut q).unwrap();
                 base.clone().then(Primal::scale(2, 0, 1.0 / 0.6))
             }
             _ => {
-                Operator::<2>::apply(&Mirror, &mut q).unwrap();
+                Operator::apply(&Mirror, &mut q).unwrap();
                 base.clone().then(Primal::scale(2, 1, -1.0))
             }
         };
@@ -37,7 +38,7 @@ fn frame_rotation_matches_ground_truth_4d() {
     let a = 0.7f64;
     let stds = [0.1, 0.3, 0.2, 0.15];
     let mut p = Cov::<4>::gaussian(stds).unwrap();
-    Operator::<4>::apply(&RotateFrame::new(a).unwrap(), &mut p).unwrap();
+    Operator::apply(&RotateFrame::new(a).unwrap(), &mut p).unwrap();
     // The new frame's x axis is the old one turned by +a toward y: z_old = R(a) z_new.
     let (s, c) = a.sin_cos();
     let m = vec![c, -s, 0.0, 0.0, s, c, 0.0, 0.0, 0.0, 0.0, c, -s, 0.0, 0.0, s, c];
@@ -76,8 +77,8 @@ fn from_vectors_finds_the_plane_of_incidence() {
 #[test]
 fn grazing_and_bad_parameters() {
     let mut c = Cov::<4>::gaussian([0.1, 0.1, 0.2, 0.2]).unwrap();
-    Operator::<4>::apply(&Project::new(1e-12).unwrap(), &mut c).unwrap();
-    Operator::<4>::apply(&Unproject::new(1e-12).unwrap(), &mut c).unwrap();
+    Operator::apply(&Project::new(1e-12).unwrap(), &mut c).unwrap();
+    Operator::apply(&Unproject::new(1e-12).unwrap(), &mut c).unwrap();
     assert!(c.validity().is_valid());
     assert!(Project::new(0.0).is_err());
     assert!(Project::new(1.5).is_err());
@@ -85,5 +86,5 @@ fn grazing_and_bad_parameters() {
     assert!(Unproject::new(-0.5).is_err());
     assert!(RotateFrame::new(f64::INFINITY).is_err());
     let mut flat = Cov::<2>::gaussian([0.1, 0.1]).unwrap();
-    assert!(Operator::<2>::apply(&Project::with_angle(0.5, 0.3).unwrap(), &mut flat).is_err());
+    assert!(Operator::apply(&Project::with_angle(0.5, 0.3).unwrap(), &mut flat).is_err());
 }

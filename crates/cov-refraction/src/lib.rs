@@ -13,11 +13,19 @@
 //! [`CovError::NoTransport`], never NaN. Near the critical angle `cos_t → 0` and the
 //! angular scale `a` grows without bound; it stays finite while `cos_t > 0`.
 //!
-//! | operator | parameter | unit | domain | meaning |
+//! Parameters, as written in a path file (`covtrace list` prints the same):
+//!
+//! <!-- parameters: generated from the specs (`COVTRACE_BLESS=1 cargo test --test param_tables`) -->
+//! | operator | parameter | unit | default | meaning |
 //! |---|---|---|---|---|
-//! | [`Refract`] | `n1`, `n2` | – | > 0 | refractive indices before and after the interface |
-//! | [`Refract`] | `cos_i` | – | (0, 1] | `|cos|` of the incident angle to the normal |
-//! | [`RoughRefract`] | `refract`, `lobe` | | | a [`Refract`] followed by a transmission lobe (cov-brdf's [`Lobe`]) on the transmitted side |
+//! | `Refract` | `n1` | – | required | Refractive index on the incident side, > 0. |
+//! |  | `n2` | – | required | Refractive index on the transmitted side, > 0. |
+//! |  | `cos_i` | – | required | `\|cos θ_i\|`, in (0, 1]; total internal reflection is an error. |
+//! | `RoughRefract` | `n1` | – | required | Refractive index on the incident side, > 0. |
+//! |  | `n2` | – | required | Refractive index on the transmitted side, > 0. |
+//! |  | `cos_i` | – | required | `\|cos θ_i\|`, in (0, 1]. |
+//! |  | `lobe` | – | required | Transmission lobe, as in `Brdf`. |
+//! <!-- end of parameters -->
 //!
 //! ```
 //! use cov_core::{Cov, Operator};
@@ -25,7 +33,7 @@
 //!
 //! let glass = Refract::new(1.0, 1.5, 0.9)?;
 //! let mut c = Cov::<2>::gaussian([0.01, 0.1])?;
-//! Operator::<2>::apply(&glass, &mut c)?;
+//! Operator::apply(&glass, &mut c)?;
 //! // Entering glass narrows the angular spread: angular frequencies go up.
 //! assert!(c.get(1, 1) > Cov::<2>::gaussian([0.01, 0.1])?.get(1, 1));
 //! // Leaving glass at a grazing angle: total internal reflection is an error.
@@ -58,7 +66,7 @@
 pub mod spec;
 
 use cov_brdf::Lobe;
-use cov_core::{Axis, Cov, CovError, Operator, Spectrum};
+use cov_core::{Axis, CovError, Operator, Spectrum};
 
 /// A smooth interface between media of indices `n1` (incident side) and `n2`.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -77,9 +85,9 @@ impl Refract {
     /// Non-positive or non-finite indices, `cos_i` not in (0, 1], or total internal
     /// reflection ([`CovError::NoTransport`]).
     pub fn new(n1: f64, n2: f64, cos_i: f64) -> Result<Self, CovError> {
-        CovError::check_positive(Self::NAME, "n1", n1)?;
-        CovError::check_positive(Self::NAME, "n2", n2)?;
-        CovError::check_range(
+        CovError::require_positive(Self::NAME, "n1", n1)?;
+        CovError::require_positive(Self::NAME, "n2", n2)?;
+        CovError::require_range(
             Self::NAME,
             "cos_i",
             cos_i,
@@ -118,17 +126,14 @@ impl Refract {
     }
 }
 
-impl<const N: usize> Operator<N> for Refract {
-    fn apply(&self, cov: &mut dyn Spectrum<N>) -> Result<(), CovError> {
+impl Operator for Refract {
+    fn apply(&self, cov: &mut dyn Spectrum) -> Result<(), CovError> {
         cov.scale(Axis::X, self.cos_i / self.cos_t)?;
         cov.scale(Axis::U, 1.0 / self.angular_scale())?;
-        if Cov::<N>::has(Axis::V) {
+        if cov.has(Axis::V) {
             cov.scale(Axis::V, self.n2 / self.n1)?;
         }
         Ok(())
-    }
-    fn name(&self) -> &str {
-        Self::NAME
     }
 }
 
@@ -153,12 +158,9 @@ impl RoughRefract {
     }
 }
 
-impl<const N: usize> Operator<N> for RoughRefract {
-    fn apply(&self, cov: &mut dyn Spectrum<N>) -> Result<(), CovError> {
-        Operator::<N>::apply(&self.refract, cov)?;
+impl Operator for RoughRefract {
+    fn apply(&self, cov: &mut dyn Spectrum) -> Result<(), CovError> {
+        Operator::apply(&self.refract, cov)?;
         self.lobe.apply_to(cov)
-    }
-    fn name(&self) -> &str {
-        Self::NAME
     }
 }

@@ -2,97 +2,51 @@
 
 use cov_brdf::Lobe;
 use cov_core::CovError;
-use cov_path::{OperatorSpec, Param, Registry};
-use serde::Deserialize;
+use cov_core::{OperatorSpec, Registrar};
 
 use crate::{Refract, RoughRefract};
 
 /// `Refract(n1: 1.0, n2: 1.5, cos_i: 0.9)`.
-#[derive(Debug, Deserialize)]
-#[serde(deny_unknown_fields)]
+#[derive(Debug, OperatorSpec)]
+#[operator(summary = "smooth refraction (Snell) at an interface")]
 pub struct RefractSpec {
-    /// Index on the incident side.
+    /// Refractive index on the incident side, > 0.
     pub n1: f64,
-    /// Index on the transmitted side.
+    /// Refractive index on the transmitted side, > 0.
     pub n2: f64,
-    /// `|cos θ_i|`.
+    /// `|cos θ_i|`, in (0, 1]; total internal reflection is an error.
     pub cos_i: f64,
 }
 
-const PARAMS: &[Param] = &[
-    Param {
-        name: "n1",
-        unit: "–",
-        doc: "> 0, incident side",
-    },
-    Param {
-        name: "n2",
-        unit: "–",
-        doc: "> 0, transmitted side",
-    },
-    Param {
-        name: "cos_i",
-        unit: "–",
-        doc: "(0, 1]; total internal reflection is an error",
-    },
-];
-
-impl OperatorSpec for RefractSpec {
-    const NAME: &'static str = Refract::NAME;
-    const SUMMARY: &'static str = "smooth refraction (Snell) at an interface";
-    const PARAMS: &'static [Param] = PARAMS;
-    type Op = Refract;
-    fn build(self) -> Result<Refract, CovError> {
-        Refract::new(self.n1, self.n2, self.cos_i)
+impl TryFrom<RefractSpec> for Refract {
+    type Error = CovError;
+    fn try_from(spec: RefractSpec) -> Result<Refract, CovError> {
+        Refract::new(spec.n1, spec.n2, spec.cos_i)
     }
 }
 
 /// `RoughRefract(n1: 1.0, n2: 1.5, cos_i: 0.9, lobe: Beckmann(alpha_u: 0.1, alpha_v: 0.1))`.
-#[derive(Debug, Deserialize)]
-#[serde(deny_unknown_fields)]
+#[derive(Debug, OperatorSpec)]
+#[operator(summary = "rough refraction: Snell then a transmission lobe")]
 pub struct RoughRefractSpec {
-    /// Index on the incident side.
+    /// Refractive index on the incident side, > 0.
     pub n1: f64,
-    /// Index on the transmitted side.
+    /// Refractive index on the transmitted side, > 0.
     pub n2: f64,
-    /// `|cos θ_i|`.
+    /// `|cos θ_i|`, in (0, 1].
     pub cos_i: f64,
-    /// Transmission lobe.
+    /// Transmission lobe, as in `Brdf`.
     pub lobe: Lobe,
 }
 
-impl OperatorSpec for RoughRefractSpec {
-    const NAME: &'static str = RoughRefract::NAME;
-    const SUMMARY: &'static str = "rough refraction: Snell then a transmission lobe";
-    const PARAMS: &'static [Param] = &[
-        Param {
-            name: "n1",
-            unit: "–",
-            doc: "> 0",
-        },
-        Param {
-            name: "n2",
-            unit: "–",
-            doc: "> 0",
-        },
-        Param {
-            name: "cos_i",
-            unit: "–",
-            doc: "(0, 1]",
-        },
-        Param {
-            name: "lobe",
-            unit: "",
-            doc: "as in Brdf",
-        },
-    ];
-    type Op = RoughRefract;
-    fn build(self) -> Result<RoughRefract, CovError> {
-        RoughRefract::new(self.n1, self.n2, self.cos_i, self.lobe)
+impl TryFrom<RoughRefractSpec> for RoughRefract {
+    type Error = CovError;
+    fn try_from(spec: RoughRefractSpec) -> Result<RoughRefract, CovError> {
+        RoughRefract::new(spec.n1, spec.n2, spec.cos_i, spec.lobe)
     }
 }
 
 /// Registers this crate's operators.
-pub fn register(r: &mut Registry) {
-    r.register::<RefractSpec>().register::<RoughRefractSpec>();
+pub fn register<R: Registrar>(r: &mut R) {
+    r.add::<RefractSpec>().add::<RoughRefractSpec>();
 }

@@ -15,7 +15,7 @@ fn refraction_matches_ground_truth_2d() {
     for (n1, n2, ci) in [(1.0, 1.5, 0.9), (1.0, 1.33, 0.3), (1.5, 1.0, 0.95)] {
         let r = Refract::new(n1, n2, ci).unwrap();
         let mut p = Cov::<2>::gaussian(stds).unwrap();
-        Operator::<2>::apply(&r, &mut p).unwrap();
+        Operator::apply(&r, &mut p).unwrap();
         let f = Field::gaussian(&stds)
             .then(Primal::scale(2, 0, ci))
             .then(Primal::scale(2, 0, 1.0 / r.cos_t()))
@@ -71,7 +71,7 @@ fn refraction_matches_vector_snell_3d() {
         let a = j.try_inverse().unwrap();
         let m = SMatrix::<f64, 4, 4>::from_fn(|i, k| if i == k { 2.0 + i as f64 } else { 0.3 });
         let mut got = Cov::<4>::from_matrix(&m).unwrap();
-        Operator::<4>::apply(&r, &mut got).unwrap();
+        Operator::apply(&r, &mut got).unwrap();
         let expected = a.transpose() * DMatrix::from_fn(4, 4, |i, k| m[(i, k)]) * &a;
         let got = DMatrix::from_fn(4, 4, |i, k| got.get(i, k));
         let err = (&got - &expected).norm() / expected.norm();
@@ -89,7 +89,7 @@ fn total_internal_reflection_is_a_typed_error() {
     let r = Refract::new(1.5, 1.0, cc * (1.0 + 1e-9)).unwrap();
     assert!(r.angular_scale().is_finite() && r.angular_scale() > 1e3);
     let mut c = Cov::<4>::gaussian([0.1, 0.1, 0.2, 0.2]).unwrap();
-    Operator::<4>::apply(&r, &mut c).unwrap();
+    Operator::apply(&r, &mut c).unwrap();
     assert!(c.validity().is_valid());
     // Normal incidence: no scaling in x and u beyond the indices.
     let r = Refract::new(1.0, 1.5, 1.0).unwrap();
@@ -99,7 +99,7 @@ fn total_internal_reflection_is_a_typed_error() {
 #[test]
 fn rough_refraction_and_bad_parameters() {
     let mut c = Cov::<2>::gaussian([0.1, 0.2]).unwrap();
-    Operator::<2>::apply(
+    Operator::apply(
         &RoughRefract::new(1.0, 1.5, 0.8, Lobe::beckmann(0.2).unwrap()).unwrap(),
         &mut c,
     )

@@ -21,17 +21,21 @@
 //! The lens position `p` of a ray reaching the sensor at `x_s` with direction `u` is
 //! `p = x_s − distance·u`, the change of variables used for the lens part of the density.
 //!
-//! | operator | parameter | unit | domain | meaning |
+//! Parameters, as written in a path file (`covtrace list` prints the same):
+//!
+//! <!-- parameters: generated from the specs (`COVTRACE_BLESS=1 cargo test --test param_tables`) -->
+//! | operator | parameter | unit | default | meaning |
 //! |---|---|---|---|---|
-//! | [`Sensor`] | `width` | px | ≥ 1 | image width |
-//! | [`Sensor`] | `fov_x` | rad | (0, π) | horizontal field of view |
-//! | [`Sensor`] | `distance` | m | > 0 | lens (or pinhole) to sensor, default 1 |
-//! | [`Sensor`] | `filter` | px | > 0 | pixel filter std, default 0.5 |
-//! | [`Sensor`] | `aperture` | m | > 0, optional | the lens's aperture std (sampled lens axes) |
-//! | [`Sensor`] | `shutter` | s | > 0, optional | the shutter's std (sampled time axis) |
-//! | [`Sensor`] | `nyquist` | – | > 0 | Nyquist factor `k`, default 2 |
-//! | [`Sensor`] | `max_filter` | px | > 0 | largest filter std, default 8 |
-//! | [`Integrate`] | `axes` | | list | integrate over these axes (rule 4) |
+//! | `Sensor` | `width` | px | required | Image width, ≥ 1. |
+//! |  | `fov_x` | rad | required | Horizontal field of view, in (0, π). |
+//! |  | `distance` | m | `1.0` | Lens (or pinhole) to sensor. |
+//! |  | `filter` | px | `0.5` | Pixel filter std. |
+//! |  | `aperture` | m | optional | Aperture std, when the lens is sampled. |
+//! |  | `shutter` | s | optional | Shutter std, when time is sampled (needs axis `t`). |
+//! |  | `nyquist` | – | `NYQUIST_K` | Nyquist factor k. |
+//! |  | `max_filter` | px | `8.0` | Largest filter std. |
+//! | `Integrate` | `axes` | – | required | Axes to integrate over: a list of `x`, `y`, `u`, `v`, `t`. |
+//! <!-- end of parameters -->
 //!
 //! As an operator, `Sensor` applies the pixel filter and integrates over `u`, `v`, `t`:
 //! the path's final Σ is then the image-space covariance in metres.
@@ -75,48 +79,45 @@ pub mod spec;
 
 use std::f64::consts::PI;
 
-use cov_core::{Axis, AxisSet, Cov, CovError, FOUR_PI_SQ, NYQUIST_K, Operator, Spectrum};
+use cov_core::{
+    AnyCov, Axis, AxisSet, CovError, FOUR_PI_SQ, Field, NYQUIST_K, Operator, Report, ReportField, Spectrum,
+    axis_index,
+};
 use serde::{Deserialize, Serialize};
 
-/// Parameters of a [`Sensor`] (see the crate docs for units and defaults).
-#[derive(Clone, Copy, Debug, PartialEq, Deserialize, Serialize)]
-#[serde(deny_unknown_fields)]
+/// Parameters of a [`Sensor`]: `Sensor(width: 640, fov_x: 0.8, …)` in a path file
+/// (`covtrace list` prints this table).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, cov_core::OperatorSpec)]
+#[operator(
+    name = "Sensor",
+    op = Sensor,
+    summary = "the sensor: pixel filter, integration over lens and shutter, per-pixel decisions"
+)]
 pub struct SensorParams {
-    /// Image width (px).
+    /// Image width, ≥ 1.
+    #[param(unit = "px")]
     pub width: u32,
-    /// Horizontal field of view (rad).
+    /// Horizontal field of view, in (0, π).
+    #[param(unit = "rad")]
     pub fov_x: f64,
-    /// Lens (or pinhole) to sensor (m).
-    #[serde(default = "one")]
+    /// Lens (or pinhole) to sensor.
+    #[param(unit = "m", default = 1.0)]
     pub distance: f64,
-    /// Pixel filter std (px).
-    #[serde(default = "half")]
+    /// Pixel filter std.
+    #[param(unit = "px", default = 0.5)]
     pub filter: f64,
-    /// Aperture std (m), when the lens is sampled.
-    #[serde(default)]
+    /// Aperture std, when the lens is sampled.
+    #[param(unit = "m", default)]
     pub aperture: Option<f64>,
-    /// Shutter std (s), when time is sampled.
-    #[serde(default)]
+    /// Shutter std, when time is sampled (needs axis `t`).
+    #[param(unit = "s", default)]
     pub shutter: Option<f64>,
     /// Nyquist factor k.
-    #[serde(default = "nyquist")]
+    #[param(default = NYQUIST_K)]
     pub nyquist: f64,
-    /// Largest filter std (px).
-    #[serde(default = "eight")]
+    /// Largest filter std.
+    #[param(unit = "px", default = 8.0)]
     pub max_filter: f64,
-}
-
-fn one() -> f64 {
-    1.0
-}
-fn half() -> f64 {
-    0.5
-}
-fn nyquist() -> f64 {
-    NYQUIST_K
-}
-fn eight() -> f64 {
-    8.0
 }
 
 impl Default for SensorParams {
@@ -179,25 +180,25 @@ impl Sensor {
                 expected: "must be ≥ 1".into(),
             });
         }
-        CovError::check_range(
+        CovError::require_range(
             Self::NAME,
             "fov_x",
             p.fov_x,
             |f| f > 0.0 && f < PI,
             "must be in (0, π)",
         )?;
-        CovError::check_positive(Self::NAME, "distance", p.distance)?;
-        CovError::check_positive(Self::NAME, "filter", p.filter)?;
-        CovError::check_positive(Self::NAME, "nyquist", p.nyquist)?;
-        CovError::check_positive(Self::NAME, "max_filter", p.max_filter)?;
+        CovError::require_positive(Self::NAME, "distance", p.distance)?;
+        CovError::require_positive(Self::NAME, "filter", p.filter)?;
+        CovError::require_positive(Self::NAME, "nyquist", p.nyquist)?;
+        CovError::require_positive(Self::NAME, "max_filter", p.max_filter)?;
         if let Some(a) = p.aperture {
-            CovError::check_positive(Self::NAME, "aperture", a)?;
+            CovError::require_positive(Self::NAME, "aperture", a)?;
         }
         if let Some(s) = p.shutter {
-            CovError::check_positive(Self::NAME, "shutter", s)?;
+            CovError::require_positive(Self::NAME, "shutter", s)?;
         }
         let pitch = 2.0 * p.distance * (0.5 * p.fov_x).tan() / f64::from(p.width);
-        CovError::check_positive(Self::NAME, "pitch", pitch)?;
+        CovError::require_positive(Self::NAME, "pitch", pitch)?;
         Ok(Sensor { p, pitch })
     }
 
@@ -211,10 +212,10 @@ impl Sensor {
         &self.p
     }
 
-    fn pixel_filter<const N: usize>(&self, cov: &mut dyn Spectrum<N>) -> Result<(), CovError> {
+    fn pixel_filter(&self, cov: &mut dyn Spectrum) -> Result<(), CovError> {
         let s = self.p.filter * self.pitch;
         let w = 1.0 / (FOUR_PI_SQ * s * s);
-        for &a in Cov::<N>::spatial_axes() {
+        for &a in cov.spatial_axes() {
             cov.add_variance(a, w)?;
         }
         Ok(())
@@ -224,10 +225,11 @@ impl Sensor {
     ///
     /// # Errors
     /// Overflow, or an aperture/shutter given for a layout without `u`/`t`.
-    pub fn decisions<const N: usize>(&self, at_sensor: &Cov<N>) -> Result<PixelDecisions, CovError> {
-        let mut c = *at_sensor;
-        self.pixel_filter(&mut c)?;
-        let image_axes = Cov::<N>::spatial_axes();
+    pub fn decisions(&self, at_sensor: impl Into<AnyCov>) -> Result<PixelDecisions, CovError> {
+        let mut c: AnyCov = at_sensor.into();
+        self.pixel_filter(c.as_spectrum_mut())?;
+        let image_axes = c.as_spectrum_mut().spatial_axes();
+        let direction_axes = c.as_spectrum_mut().direction_axes();
         let n_img = image_axes.len();
         // Image-space Σ: integrate over everything but position, in pixel units.
         let img_px = scaled_block(&c, image_axes, self.pitch)?;
@@ -238,10 +240,10 @@ impl Sensor {
         // Sampled domain: image, lens (with an aperture), time (with a shutter).
         let mut keep: Vec<Axis> = image_axes.to_vec();
         if self.p.aperture.is_some() {
-            keep.extend_from_slice(Cov::<N>::direction_axes());
+            keep.extend_from_slice(direction_axes);
         }
         if self.p.shutter.is_some() {
-            Cov::<N>::index(Axis::T)?;
+            axis_index(c.dim(), Axis::T)?;
             keep.push(Axis::T);
         }
         let block = c.integrated(&keep)?.to_dmatrix();
@@ -301,48 +303,20 @@ impl Sensor {
         })
     }
 
-    /// [`Sensor::decisions`] for a layout-erased Σ (`N` rows of `N` numbers).
+    /// [`Sensor::decisions`] for Σ given as rows.
     ///
     /// # Errors
     /// As [`Sensor::decisions`], or a matrix that is not a valid Σ of size 2 to 5.
     pub fn decisions_rows(&self, rows: &[Vec<f64>]) -> Result<PixelDecisions, CovError> {
-        fn go<const N: usize>(s: &Sensor, rows: &[Vec<f64>]) -> Result<PixelDecisions, CovError> {
-            if rows.iter().any(|r| r.len() != N) {
-                return Err(CovError::Shape {
-                    what: "Sensor::decisions_rows".into(),
-                    expected: format!("{N} numbers per row"),
-                    got: "ragged rows".into(),
-                });
-            }
-            let m = nalgebra::SMatrix::<f64, N, N>::from_fn(|i, j| rows[i][j]);
-            s.decisions(&Cov::<N>::from_matrix(&m)?)
-        }
-        match rows.len() {
-            2 => go::<2>(self, rows),
-            3 => go::<3>(self, rows),
-            4 => go::<4>(self, rows),
-            5 => go::<5>(self, rows),
-            n => Err(CovError::Shape {
-                what: "Sensor::decisions_rows".into(),
-                expected: "2 to 5 rows".into(),
-                got: format!("{n}"),
-            }),
-        }
+        self.decisions(AnyCov::from_rows(rows)?)
     }
 }
 
 /// The image block in pixel units, from Σ integrated over everything but position.
-fn scaled_block<const N: usize>(
-    c: &Cov<N>,
-    image: &[Axis],
-    pitch: f64,
-) -> Result<cov_core::CovBlock, CovError> {
-    let mut s = *c;
-    let others: Vec<Axis> = Cov::<N>::axes()
-        .iter()
-        .copied()
-        .filter(|a| !image.contains(a))
-        .collect();
+fn scaled_block(c: &AnyCov, image: &[Axis], pitch: f64) -> Result<cov_core::CovBlock, CovError> {
+    let mut any = *c;
+    let s = any.as_spectrum_mut();
+    let others: Vec<Axis> = s.axes().iter().copied().filter(|a| !image.contains(a)).collect();
     if !others.is_empty() {
         s.integrate(&others)?;
     }
@@ -350,20 +324,68 @@ fn scaled_block<const N: usize>(
     for &a in image {
         s.scale(a, pitch)?;
     }
-    s.marginal(image)
+    any.marginal(image)
 }
 
-impl<const N: usize> Operator<N> for Sensor {
-    fn apply(&self, cov: &mut dyn Spectrum<N>) -> Result<(), CovError> {
+impl Operator for Sensor {
+    fn apply(&self, cov: &mut dyn Spectrum) -> Result<(), CovError> {
         self.pixel_filter(cov)?;
-        let mut rest: Vec<Axis> = Cov::<N>::direction_axes().to_vec();
-        if Cov::<N>::has(Axis::T) {
+        let mut rest: Vec<Axis> = cov.direction_axes().to_vec();
+        if cov.has(Axis::T) {
             rest.push(Axis::T);
         }
         cov.integrate(&rest)
     }
-    fn name(&self) -> &str {
-        Self::NAME
+    /// A shutter samples time: the path needs `t`.
+    fn requires(&self) -> AxisSet {
+        if self.p.shutter.is_some() {
+            AxisSet::FLAT_TIME
+        } else {
+            AxisSet::FLAT
+        }
+    }
+    /// The per-pixel decisions ([`PixelDecisions`]) from Σ arriving at the sensor.
+    fn report(&self, before: &AnyCov) -> Result<Option<Report>, CovError> {
+        Ok(Some(self.decisions(*before)?.to_report()))
+    }
+    /// A sensor ends a path.
+    fn is_terminal(&self) -> bool {
+        true
+    }
+}
+
+impl PixelDecisions {
+    /// The decisions as a [`Report`] (fields named as `covtrace eval` prints them; the
+    /// typed value is this struct).
+    pub fn to_report(&self) -> Report {
+        let f = |name: &str, unit: &str, value: Field| ReportField::new(name, unit, value);
+        Report::new(
+            "per pixel (sensor)",
+            vec![
+                f("image axes", "", Field::Text(self.image_axes.clone())),
+                f(
+                    "image covariance",
+                    "(cycles/px)²",
+                    Field::Matrix(self.image_cov_px.clone()),
+                ),
+                f(
+                    "image bandwidth",
+                    "cycles/px",
+                    Field::Numbers(self.image_bandwidth_px.clone()),
+                ),
+                f("filter std", "px", Field::Numbers(self.filter_std_px.clone())),
+                f(
+                    "filter directions",
+                    "",
+                    Field::Matrix(self.filter_directions.clone()),
+                ),
+                f("filter clamped", "", Field::Flag(self.filter_clamped)),
+                f("sampled domain", "", Field::Text(self.sampled_axes.clone())),
+                f("density", "samples per unit volume", Field::Number(self.density)),
+                f("samples per pixel", "", Field::Number(self.samples_per_pixel)),
+            ],
+            self.clone(),
+        )
     }
 }
 
@@ -391,12 +413,9 @@ impl Integrate {
     }
 }
 
-impl<const N: usize> Operator<N> for Integrate {
-    fn apply(&self, cov: &mut dyn Spectrum<N>) -> Result<(), CovError> {
+impl Operator for Integrate {
+    fn apply(&self, cov: &mut dyn Spectrum) -> Result<(), CovError> {
         cov.integrate(&self.axes)
-    }
-    fn name(&self) -> &str {
-        Self::NAME
     }
     fn requires(&self) -> AxisSet {
         AxisSet::of(&self.axes).union(AxisSet::FLAT)

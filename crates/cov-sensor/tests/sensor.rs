@@ -24,7 +24,7 @@ fn image_space_units_and_filter() {
     let pitch = s.pitch();
     assert!((pitch - 2.0 * 0.05 * 0.3f64.tan() / 800.0).abs() < 1e-18);
     let c = Cov::<2>::from_diagonal([4e6, 10.0]).unwrap();
-    let d = s.decisions(&c).unwrap();
+    let d = s.decisions(c).unwrap();
     // Pixel filter window then integration over u (no x–u correlation): Σ_xx + w.
     let w = 1.0 / (4.0 * PI * PI * (0.5 * pitch).powi(2));
     let expected = (4e6 + w) * pitch * pitch;
@@ -51,14 +51,14 @@ fn static_scene_in_5d_matches_4d() {
     let m5 = nalgebra::SMatrix::<f64, 5, 5>::from_fn(|i, j| if i < 4 && j < 4 { m4[(i, j)] } else { 0.0 });
     let c5 = Cov::<5>::from_matrix(&m5).unwrap();
     for s in [sensor(None, None), sensor(Some(0.004), None)] {
-        let (a, b) = (s.decisions(&c4).unwrap(), s.decisions(&c5).unwrap());
+        let (a, b) = (s.decisions(c4).unwrap(), s.decisions(c5).unwrap());
         assert_eq!(a.image_cov_px, b.image_cov_px);
         assert_eq!(a.density, b.density);
     }
     let mut o4 = c4;
     let mut o5 = c5;
-    Operator::<4>::apply(&sensor(None, None), &mut o4).unwrap();
-    Operator::<5>::apply(&sensor(None, None), &mut o5).unwrap();
+    Operator::apply(&sensor(None, None), &mut o4).unwrap();
+    Operator::apply(&sensor(None, None), &mut o5).unwrap();
     for i in 0..4 {
         for j in 0..4 {
             assert_eq!(o4.get(i, j), o5.get(i, j));
@@ -70,22 +70,22 @@ fn static_scene_in_5d_matches_4d() {
 fn lens_and_time_enter_the_sampled_domain() {
     let m = nalgebra::SMatrix::<f64, 3, 3>::from_fn(|i, j| if i == j { [4e6, 40.0, 900.0][i] } else { 0.0 });
     let c = Cov::<3>::from_matrix(&m).unwrap();
-    let d = sensor(Some(0.004), Some(0.01)).decisions(&c).unwrap();
+    let d = sensor(Some(0.004), Some(0.01)).decisions(c).unwrap();
     assert_eq!(d.sampled_axes, ["x_px", "lens_x", "t"]);
     assert!(d.samples_per_pixel > 0.0 && d.samples_per_pixel.is_finite());
     // More shutter content (a faster moving edge) means more samples.
     let m2 = nalgebra::SMatrix::<f64, 3, 3>::from_fn(|i, j| if i == j { [4e6, 40.0, 9e4][i] } else { 0.0 });
     let d2 = sensor(Some(0.004), Some(0.01))
-        .decisions(&Cov::<3>::from_matrix(&m2).unwrap())
+        .decisions(Cov::<3>::from_matrix(&m2).unwrap())
         .unwrap();
     assert!(d2.samples_per_pixel > d.samples_per_pixel);
     // A shutter needs t.
-    assert!(sensor(None, Some(0.01)).decisions(&Cov::<2>::zeros()).is_err());
+    assert!(sensor(None, Some(0.01)).decisions(Cov::<2>::zeros()).is_err());
 }
 
 #[test]
 fn zero_spectrum_gives_the_widest_filter_and_no_nan() {
-    let d = sensor(None, None).decisions(&Cov::<4>::zeros()).unwrap();
+    let d = sensor(None, None).decisions(Cov::<4>::zeros()).unwrap();
     assert!(d.filter_std_px.iter().all(|v| v.is_finite() && *v > 0.0));
     assert!(d.density.is_finite());
 }
@@ -111,6 +111,6 @@ fn bad_parameters_and_integrate() {
     );
     assert!(Integrate::new(vec![]).is_err());
     let mut c = Cov::<3>::gaussian([0.1, 0.2, 0.3]).unwrap();
-    Operator::<3>::apply(&Integrate::new(vec![Axis::T]).unwrap(), &mut c).unwrap();
+    Operator::apply(&Integrate::new(vec![Axis::T]).unwrap(), &mut c).unwrap();
     assert_eq!(c.get(2, 2), 0.0);
 }

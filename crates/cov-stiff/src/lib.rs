@@ -257,7 +257,7 @@ pub fn ours_eval(case: &Case, form: Form) -> Result<DMatrix<f64>, CovError> {
 fn ours_n<const N: usize>(case: &Case, form: Form) -> Result<DMatrix<f64>, CovError> {
     let m = nalgebra::SMatrix::<f64, N, N>::from_fn(|i, j| case.start[i * N + j]);
     let start = Cov::<N>::from_matrix(&m)?;
-    let mut chain = Chain::<N>::new();
+    let mut chain = Chain::new();
     for &op in &case.ops {
         match op {
             StiffOp::Travel(d) => chain.push(Travel::new(d)?),
@@ -273,7 +273,7 @@ fn ours_n<const N: usize>(case: &Case, form: Form) -> Result<DMatrix<f64>, CovEr
                 chain.push(cov_motion::Moving::new(
                     [v, 0.0],
                     [0.0, 0.0],
-                    vec![cov_path::DynOperator(std::sync::Arc::new(window))],
+                    cov_core::Chain::new().with(window),
                 )?);
             }
         }

@@ -7,9 +7,13 @@
 //! **Spectrum**: rule 1 with `A = [[1, −d], [0, 1]]`, i.e. `Σ_uu += −2d Σ_xu + d² Σ_xx`
 //! and `Σ_xu −= d Σ_xx`: spatial frequencies leak into angle as light travels.
 //!
-//! | parameter | unit | domain | meaning |
-//! |---|---|---|---|
-//! | `distance` | m | finite (negative travels back) | length travelled along the ray |
+//! Parameters, as written in a path file (`covtrace list` prints the same):
+//!
+//! <!-- parameters: generated from the specs (`COVTRACE_BLESS=1 cargo test --test param_tables`) -->
+//! | operator | parameter | unit | default | meaning |
+//! |---|---|---|---|---|
+//! | `Travel` | `distance` | m | required | Distance (m); finite; negative travels back |
+//! <!-- end of parameters -->
 //!
 //! Layouts: all (N = 2, 3, 4, 5); needs `x, u`.
 //!
@@ -18,7 +22,7 @@
 //! use cov_travel::Travel;
 //!
 //! let mut c = Cov::<2>::gaussian([0.01, f64::INFINITY])?; // a 1 cm spot, diffuse emitter
-//! Operator::<2>::apply(&Travel::new(2.0)?, &mut c)?;
+//! Operator::apply(&Travel::new(2.0)?, &mut c)?;
 //! // Σ_uu = d² Σ_xx: the spot's spatial content now shows in angle.
 //! assert!((c.get(1, 1) - 4.0 * c.get(0, 0)).abs() < 1e-9 * c.get(1, 1));
 //! # Ok::<(), cov_core::CovError>(())
@@ -42,7 +46,7 @@
 
 pub mod spec;
 
-use cov_core::{Cov, CovError, Operator, Spectrum};
+use cov_core::{CovError, Operator, Spectrum};
 
 /// Travel by `distance` metres along the ray.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -57,7 +61,7 @@ impl Travel {
     /// # Errors
     /// [`CovError::NonFinite`] if `distance` is NaN or infinite.
     pub fn new(distance: f64) -> Result<Self, CovError> {
-        CovError::check_finite(Self::NAME, "distance", distance)?;
+        CovError::require_finite(Self::NAME, "distance", distance)?;
         Ok(Travel { distance })
     }
 
@@ -67,15 +71,11 @@ impl Travel {
     }
 }
 
-impl<const N: usize> Operator<N> for Travel {
-    fn apply(&self, cov: &mut dyn Spectrum<N>) -> Result<(), CovError> {
-        for &(p, d) in Cov::<N>::transverse_pairs() {
+impl Operator for Travel {
+    fn apply(&self, cov: &mut dyn Spectrum) -> Result<(), CovError> {
+        for &(p, d) in cov.transverse_pairs() {
             cov.shear(p, d, -self.distance)?;
         }
         Ok(())
-    }
-
-    fn name(&self) -> &str {
-        Self::NAME
     }
 }

@@ -1,34 +1,27 @@
 //! RON parameters of the travel operator.
 
 use cov_core::CovError;
-use cov_path::{OperatorSpec, Param, Registry};
-use serde::Deserialize;
+use cov_core::{OperatorSpec, Registrar};
 
 use crate::Travel;
 
 /// `Travel(distance: 1.5)`.
-#[derive(Debug, Deserialize)]
-#[serde(deny_unknown_fields)]
+#[derive(Debug, OperatorSpec)]
+#[operator(summary = "free-space travel along the ray")]
 pub struct TravelSpec {
-    /// Distance (m).
+    /// Distance (m); finite; negative travels back
+    #[param(unit = "m")]
     pub distance: f64,
 }
 
-impl OperatorSpec for TravelSpec {
-    const NAME: &'static str = Travel::NAME;
-    const SUMMARY: &'static str = "free-space travel along the ray";
-    const PARAMS: &'static [Param] = &[Param {
-        name: "distance",
-        unit: "m",
-        doc: "finite; negative travels back",
-    }];
-    type Op = Travel;
-    fn build(self) -> Result<Travel, CovError> {
-        Travel::new(self.distance)
+impl TryFrom<TravelSpec> for Travel {
+    type Error = CovError;
+    fn try_from(spec: TravelSpec) -> Result<Travel, CovError> {
+        Travel::new(spec.distance)
     }
 }
 
 /// Registers this crate's operators.
-pub fn register(r: &mut Registry) {
-    r.register::<TravelSpec>();
+pub fn register<R: Registrar>(r: &mut R) {
+    r.add::<TravelSpec>();
 }

@@ -12,7 +12,7 @@
 //! axis in 2D/3D, 24–32 in 4D, 16 in 5D keep a case under a second in release builds).
 //!
 //! ```
-//! use cov_core::{Axis, Cov};
+//! use cov_core::{Axis, Cov, Spectrum};
 //! use cov_validate::{Field, Grid, Primal, compare};
 //!
 //! // A Gaussian spot (std 0.1 m, constant in angle) after a travel of 0.5 m.

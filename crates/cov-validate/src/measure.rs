@@ -242,7 +242,7 @@ pub fn compare<const N: usize>(
 mod tests {
     use super::*;
     use crate::Primal;
-    use cov_core::Axis;
+    use cov_core::{Axis, Spectrum};
 
     #[test]
     fn gaussian_fields_measure_their_closed_form() {

@@ -12,7 +12,7 @@ fn glitter_path_evaluates() {
     assert_eq!(e.layout, 4);
     assert_eq!(e.steps[2].operator, "Sparkle");
     // The flakes add spatial frequency: 1/(4π² · 0.0005²) ≈ 1.0e5 (cycles/m)².
-    assert!(e.steps[2].matrix[0][0] > 1.0e5);
+    assert!(e.steps[2].matrix.get(0, 0) > 1.0e5);
 }
 
 #[test]

@@ -21,11 +21,9 @@
 //!   inverted;
 //! - rule 4 is rule 3 with `S = 0`.
 
-use nalgebra::SMatrix;
-
-use crate::kernels::{SCHUR_SNAP, block_from_slice, resolve, two_axes};
+use crate::form::cov::{SCHUR_SNAP, layout_mismatch};
 use crate::linalg::{MAX, Small, sym_eigen};
-use crate::{Axis, Cov, CovError};
+use crate::{AnyCov, AnySpectrum, Cov, CovError, Form, Spectrum};
 
 /// The factor's rank decision after a Schur update, on row norms (dimensionless): a row
 /// whose norm fell to at most `ROW_SNAP ×` its norm before holds rounding only and becomes
@@ -49,7 +47,7 @@ type Work = [[f64; W]; MAX];
 /// is not unique (any `L Q` with `Q` orthogonal is the same Σ); only Σ is compared.
 ///
 /// ```
-/// use cov_core::{Axis, Cov, CovError, CovFactor};
+/// use cov_core::{Axis, Cov, CovError, CovFactor, Spectrum};
 ///
 /// let start = Cov::<2>::gaussian([1e-3, 0.05])?;
 /// let mut f = CovFactor::from_cov(&start);
@@ -219,68 +217,97 @@ impl<const N: usize> CovFactor<N> {
         *self = f;
         Ok(())
     }
+}
 
-    /// Rule 1: `Σ' = Aᵀ Σ A`, i.e. `L' = Aᵀ L`.
-    ///
-    /// # Errors
-    /// A non-finite entry in `a`, or an overflowing result (Σ is left unchanged).
-    pub fn congruence(&mut self, a: &SMatrix<f64, N, N>) -> Result<(), CovError> {
-        if let Some(v) = a.iter().copied().find(|v| !v.is_finite()) {
-            return Err(CovError::NonFinite {
-                operator: "congruence".into(),
-                parameter: "A".into(),
-                value: v,
-            });
+impl<const N: usize> Spectrum for CovFactor<N> {
+    #[inline(always)]
+    fn dim(&self) -> usize {
+        N
+    }
+    fn form(&self) -> Form {
+        Form::SquareRoot
+    }
+    fn cov(&self) -> Result<AnyCov, CovError> {
+        self.to_cov().map(AnyCov::from)
+    }
+    fn assign(&mut self, c: &AnyCov) -> Result<(), CovError> {
+        let c = c.to::<N>().ok_or_else(|| layout_mismatch(N, c.dim()))?;
+        c.check_finite("assign")?;
+        *self = CovFactor::from_cov(&c);
+        Ok(())
+    }
+    fn snapshot(&self) -> AnySpectrum {
+        AnySpectrum::from(*self)
+    }
+    fn restore(&mut self, s: &AnySpectrum) {
+        if let Some(f) = s.to_factor::<N>() {
+            *self = f;
         }
+    }
+    fn first_non_finite(&self) -> Option<(usize, usize, f64)> {
+        self.check_finite("").err().map(|e| match e {
+            CovError::Overflow { row, col, value, .. } => (row, col, value),
+            _ => (0, 0, f64::NAN),
+        })
+    }
+
+    /// `L' = Aᵀ L`.
+    fn raw_congruence(&mut self, op: &str, a: &Small) -> Result<(), CovError> {
         let mut new = [[0.0; N]; N];
         for (i, row) in new.iter_mut().enumerate() {
             for (c, v) in row.iter_mut().enumerate() {
-                *v = (0..N).map(|k| a[(k, i)] * self.l[k][c]).sum();
+                *v = (0..N).map(|k| a[k][i] * self.l[k][c]).sum();
             }
         }
-        self.commit("congruence", new)
+        self.commit(op, new)
     }
 
-    /// Rule 1, elementary shear (as [`Cov::shear`]): row `source` += `s ×` row `target`.
-    ///
-    /// # Errors
-    /// Missing axis, `target == source`, non-finite `s`, overflow.
-    pub fn shear(&mut self, target: Axis, source: Axis, s: f64) -> Result<(), CovError> {
-        CovError::check_finite("shear", "s", s)?;
-        let (i, j) = two_axes::<N>("shear", target, source)?;
+    /// Row `j` += `s ×` row `i`.
+    fn raw_shear(&mut self, op: &str, i: usize, j: usize, s: f64) -> Result<(), CovError> {
         let mut new = self.l;
         for c in 0..N {
             new[j][c] += s * self.l[i][c];
         }
-        self.commit("shear", new)
+        self.commit(op, new)
     }
 
-    /// Rule 1, scaling (as [`Cov::scale`]): row `axis` times `c`.
-    ///
-    /// # Errors
-    /// Missing axis, non-finite `c`, overflow.
-    pub fn scale(&mut self, axis: Axis, c: f64) -> Result<(), CovError> {
-        CovError::check_finite("scale", "c", c)?;
-        let i = Cov::<N>::index(axis)?;
+    /// Row `i` times `c`.
+    fn raw_scale(&mut self, op: &str, i: usize, c: f64) -> Result<(), CovError> {
         let mut new = self.l;
         for v in new[i].iter_mut() {
             *v *= c;
         }
-        self.commit("scale", new)
+        self.commit(op, new)
     }
 
-    /// Rule 1, rotation in the plane of two axes (as [`Cov::rotate`]).
-    ///
-    /// # Errors
-    /// Missing axis, `a == b`, non-finite `angle`.
-    pub fn rotate(&mut self, a: Axis, b: Axis, angle: f64) -> Result<(), CovError> {
-        CovError::check_finite("rotate", "angle", angle)?;
-        let (i, j) = two_axes::<N>("rotate", a, b)?;
-        let (s, c) = angle.sin_cos();
-        self.rotate_rows(i, j, c, s);
+    /// Rows rotated in each plane (an orthogonal map: it cannot overflow).
+    fn raw_rotate(&mut self, _op: &str, planes: &[(usize, usize)], c: f64, s: f64) -> Result<(), CovError> {
+        for &(i, j) in planes {
+            self.rotate_rows(i, j, c, s);
+        }
         Ok(())
     }
 
+    /// The columns of `W`'s factor are appended and the factor folded back.
+    fn raw_add_window(&mut self, op: &str, p: &[usize], w: &Small) -> Result<(), CovError> {
+        let k = p.len();
+        let wf = psd_factor(k, w);
+        let mut m = self.work();
+        for a in 0..k {
+            for c in 0..k {
+                m[p[a]][N + c] = wf[a][c];
+            }
+        }
+        self.fold(op, m, N + k)
+    }
+
+    /// Rule 3 by Potter's update per axis (diagonal `S`) or the array algorithm.
+    fn raw_lobe(&mut self, op: &str, p: &[usize], s: &Small) -> Result<(), CovError> {
+        self.lobe(op, p, s)
+    }
+}
+
+impl<const N: usize> CovFactor<N> {
     fn rotate_rows(&mut self, i: usize, j: usize, c: f64, s: f64) {
         for k in 0..N {
             let (x, y) = (self.l[i][k], self.l[j][k]);
@@ -289,84 +316,16 @@ impl<const N: usize> CovFactor<N> {
         }
     }
 
-    /// Rotation of the 3D tangent frame (as [`Cov::rotate_frame`]).
-    ///
-    /// # Errors
-    /// [`CovError::MissingAxis`] in flatland; non-finite `angle`.
-    pub fn rotate_frame(&mut self, angle: f64) -> Result<(), CovError> {
-        CovError::check_finite("rotate_frame", "angle", angle)?;
-        let (x, y, u, v) = (
-            Cov::<N>::index(Axis::X)?,
-            Cov::<N>::index(Axis::Y)?,
-            Cov::<N>::index(Axis::U)?,
-            Cov::<N>::index(Axis::V)?,
-        );
-        let (s, c) = angle.sin_cos();
-        self.rotate_rows(x, y, c, s);
-        self.rotate_rows(u, v, c, s);
-        Ok(())
-    }
-
-    /// Rule 2 on one axis (as [`Cov::add_variance`]): a column `√w e_axis` is appended and
-    /// the factor folded back.
-    ///
-    /// # Errors
-    /// Missing axis, `w` negative or non-finite, overflow.
-    pub fn add_variance(&mut self, axis: Axis, w: f64) -> Result<(), CovError> {
-        CovError::check_non_negative("add_variance", "w", w)?;
-        let i = Cov::<N>::index(axis)?;
-        if w == 0.0 {
-            return Ok(());
+    /// The same factor as a `CovFactor<M>` when `M == N` (`None` otherwise).
+    pub fn cast<const M: usize>(&self) -> Option<CovFactor<M>> {
+        if M != N {
+            return None;
         }
-        let mut m = self.work();
-        m[i][N] = w.sqrt();
-        self.fold("add_variance", m, N + 1)
-    }
-
-    /// Rule 2 (as [`Cov::add_window`]): the columns of `W`'s eigen-factor are appended and
-    /// the factor folded back.
-    ///
-    /// # Errors
-    /// Missing or repeated axis, wrong size, `W` not finite, symmetric and PSD; overflow.
-    pub fn add_window(&mut self, axes: &[Axis], w: &[f64]) -> Result<(), CovError> {
-        let (idx, k) = resolve::<N>("add_window", axes)?;
-        let wm = block_from_slice("add_window", "W", k, w)?;
-        let wf = psd_factor(k, &wm);
-        let mut m = self.work();
-        for a in 0..k {
-            for c in 0..k {
-                m[idx[a]][N + c] = wf[a][c];
-            }
+        let mut l = [[0.0; M]; M];
+        for i in 0..M {
+            l[i].copy_from_slice(&self.l[i][..M]);
         }
-        self.fold("add_window", m, N + k)
-    }
-
-    /// Rule 3 (as [`Cov::convolve`]) by the array algorithm; no inverse is formed.
-    ///
-    /// # Errors
-    /// Missing or repeated axis, wrong size, `S` not finite/symmetric/PSD; overflow.
-    pub fn convolve(&mut self, axes: &[Axis], s: &[f64]) -> Result<(), CovError> {
-        let (idx, k) = resolve::<N>("convolve", axes)?;
-        let sm = match (k, s) {
-            (1, [s1]) => {
-                // One axis: S is a non-negative number; no eigen-check needed.
-                CovError::check_non_negative("convolve", "S", *s1)?;
-                let mut m = [[0.0; MAX]; MAX];
-                m[0][0] = *s1;
-                m
-            }
-            _ => block_from_slice("convolve", "S", k, s)?,
-        };
-        self.lobe("convolve", &idx[..k], &sm)
-    }
-
-    /// Rule 4 (as [`Cov::integrate`]): rule 3 with `S = 0`; the integrated rows become 0.
-    ///
-    /// # Errors
-    /// Missing or repeated axis.
-    pub fn integrate(&mut self, axes: &[Axis]) -> Result<(), CovError> {
-        let (idx, k) = resolve::<N>("integrate", axes)?;
-        self.lobe("integrate", &idx[..k], &[[0.0; MAX]; MAX])
+        Some(CovFactor { l })
     }
 
     /// The factor in a work array, columns `0..N`.

@@ -1,0 +1,276 @@
+//! # cov-derive: `#[derive(OperatorSpec)]`
+//!
+//! Declares an operator's parameters once, on the fields of its spec struct. See
+//! `cov_core::spec` for the attributes and a complete example; the derive is re-exported
+//! as `cov_core::OperatorSpec`.
+//!
+//! | attribute | on | meaning |
+//! |---|---|---|
+//! | `#[operator(name = "Travel")]` | struct | name in files (default: the struct's name without `Spec`) |
+//! | `#[operator(op = Travel)]` | struct | the operator type, built by `TryFrom<Spec>` (default: the name) |
+//! | `#[operator(summary = "…")]` | struct | one line for `covtrace list` (required) |
+//! | `/// text` | field | the parameter's documentation |
+//! | `#[param(unit = "m")]` | field | its unit (default: none) |
+//! | `#[param(default)]`, `#[param(default = expr)]` | field | optional, with `Default::default()` or `expr` |
+//! | `#[param(nested)]` | field | a `Chain` written as an operator list (read with the caller's registry) |
+
+use proc_macro::TokenStream;
+use proc_macro2::TokenStream as Tokens;
+use quote::{format_ident, quote};
+use syn::{Data, DeriveInput, Expr, Fields, Ident, LitStr, Path, spanned::Spanned};
+
+/// Derives `cov_core::OperatorSpec` for a struct of named parameters.
+#[proc_macro_derive(OperatorSpec, attributes(operator, param))]
+pub fn derive_operator_spec(input: TokenStream) -> TokenStream {
+    let input = syn::parse_macro_input!(input as DeriveInput);
+    match expand(&input) {
+        Ok(t) => t.into(),
+        Err(e) => e.to_compile_error().into(),
+    }
+}
+
+/// The path to cov-core as the deriving crate sees it: `cov_core` when it depends on
+/// cov-core, else the facade `covtrace`, which re-exports it.
+fn core_path() -> Tokens {
+    use proc_macro_crate::{FoundCrate, crate_name};
+    match crate_name("cov-core") {
+        // cov-core never derives on itself; its doctests and tests see it as `cov_core`.
+        Ok(FoundCrate::Itself) => quote!(::cov_core),
+        Ok(FoundCrate::Name(n)) => {
+            let id = format_ident!("{}", n);
+            quote!(::#id)
+        }
+        Err(_) => match crate_name("covtrace") {
+            Ok(FoundCrate::Name(n)) => {
+                let id = format_ident!("{}", n);
+                quote!(::#id)
+            }
+            _ => quote!(::covtrace),
+        },
+    }
+}
+
+struct FieldSpec {
+    ident: Ident,
+    ty: syn::Type,
+    name: String,
+    unit: String,
+    doc: String,
+    default: Option<Option<Expr>>,
+    nested: bool,
+}
+
+fn doc_of(attrs: &[syn::Attribute]) -> String {
+    let mut lines = Vec::new();
+    for a in attrs {
+        if a.path().is_ident("doc")
+            && let syn::Meta::NameValue(nv) = &a.meta
+            && let Expr::Lit(syn::ExprLit {
+                lit: syn::Lit::Str(s),
+                ..
+            }) = &nv.value
+        {
+            lines.push(s.value().trim().to_string());
+        }
+    }
+    lines.join(" ").trim().to_string()
+}
+
+fn expand(input: &DeriveInput) -> syn::Result<Tokens> {
+    let ty = &input.ident;
+    let base = ty.to_string();
+    let base = base.strip_suffix("Spec").unwrap_or(&base).to_string();
+    let mut name = base.clone();
+    let mut op: Option<Path> = None;
+    let mut summary: Option<String> = None;
+    for a in &input.attrs {
+        if !a.path().is_ident("operator") {
+            continue;
+        }
+        a.parse_nested_meta(|m| {
+            if m.path.is_ident("name") {
+                name = m.value()?.parse::<LitStr>()?.value();
+            } else if m.path.is_ident("op") {
+                op = Some(m.value()?.parse::<Path>()?);
+            } else if m.path.is_ident("summary") {
+                summary = Some(m.value()?.parse::<LitStr>()?.value());
+            } else {
+                return Err(m.error("expected `name`, `op` or `summary`"));
+            }
+            Ok(())
+        })?;
+    }
+    let summary = summary.ok_or_else(|| {
+        syn::Error::new(
+            input.ident.span(),
+            "#[derive(OperatorSpec)] needs #[operator(summary = \"…\")]",
+        )
+    })?;
+    let op = match op {
+        Some(p) => p,
+        None => {
+            let id = format_ident!("{}", base);
+            syn::parse_quote!(#id)
+        }
+    };
+    let Data::Struct(data) = &input.data else {
+        return Err(syn::Error::new(input.span(), "OperatorSpec derives on structs"));
+    };
+    let fields: Vec<&syn::Field> = match &data.fields {
+        Fields::Named(n) => n.named.iter().collect(),
+        Fields::Unit => Vec::new(),
+        Fields::Unnamed(_) => {
+            return Err(syn::Error::new(
+                data.fields.span(),
+                "OperatorSpec needs named fields",
+            ));
+        }
+    };
+    let mut specs = Vec::new();
+    for f in fields {
+        let ident = f
+            .ident
+            .clone()
+            .ok_or_else(|| syn::Error::new(f.span(), "unnamed field"))?;
+        let mut unit = String::new();
+        let mut default = None;
+        let mut nested = false;
+        for a in &f.attrs {
+            if !a.path().is_ident("param") {
+                continue;
+            }
+            a.parse_nested_meta(|m| {
+                if m.path.is_ident("unit") {
+                    unit = m.value()?.parse::<LitStr>()?.value();
+                } else if m.path.is_ident("default") {
+                    if m.input.peek(syn::Token![=]) {
+                        default = Some(Some(m.value()?.parse::<Expr>()?));
+                    } else {
+                        default = Some(None);
+                    }
+                } else if m.path.is_ident("nested") {
+                    nested = true;
+                } else {
+                    return Err(m.error("expected `unit`, `default` or `nested`"));
+                }
+                Ok(())
+            })?;
+        }
+        let name = ident.to_string().trim_start_matches("r#").to_string();
+        specs.push(FieldSpec {
+            ident,
+            ty: f.ty.clone(),
+            name,
+            unit,
+            doc: doc_of(&f.attrs),
+            default,
+            nested,
+        });
+    }
+
+    let core = core_path();
+    let serde = quote!(#core::__serde);
+    let names: Vec<&String> = specs.iter().map(|f| &f.name).collect();
+    let params = specs.iter().map(|f| {
+        let (n, u, d) = (&f.name, &f.unit, &f.doc);
+        let def = match &f.default {
+            None => quote!(::core::option::Option::None),
+            Some(None) => quote!(::core::option::Option::Some(#core::spec::OPTIONAL)),
+            Some(Some(e)) => {
+                let s = quote!(#e).to_string();
+                quote!(::core::option::Option::Some(#s))
+            }
+        };
+        quote!(#core::Param { name: #n, unit: #u, doc: #d, default: #def })
+    });
+    let slots: Vec<Ident> = specs.iter().map(|f| format_ident!("__{}", f.ident)).collect();
+    let decls = specs.iter().zip(&slots).map(|(f, s)| {
+        let t = &f.ty;
+        quote!(let mut #s: ::core::option::Option<#t> = ::core::option::Option::None;)
+    });
+    let arms = specs.iter().zip(&slots).map(|(f, s)| {
+        let n = &f.name;
+        let read = if f.nested {
+            quote!(#serde::de::MapAccess::next_value_seed(&mut __map, #core::spec::NestedSeed(self.0))?)
+        } else {
+            quote!(#serde::de::MapAccess::next_value(&mut __map)?)
+        };
+        quote!(#n => {
+            if #s.is_some() {
+                return ::core::result::Result::Err(<__A::Error as #serde::de::Error>::duplicate_field(#n));
+            }
+            #s = ::core::option::Option::Some(#read);
+        })
+    });
+    let default_value = |f: &FieldSpec| match &f.default {
+        Some(Some(e)) => Some(quote!(::core::convert::Into::into(#e))),
+        Some(None) => Some(quote!(::core::default::Default::default())),
+        None => None,
+    };
+    let finish = specs.iter().zip(&slots).map(|(f, s)| {
+        let id = &f.ident;
+        let n = &f.name;
+        match default_value(f) {
+            Some(d) => quote!(#id: match #s { ::core::option::Option::Some(v) => v, ::core::option::Option::None => #d },),
+            None => quote!(#id: #s.ok_or_else(|| <__A::Error as #serde::de::Error>::missing_field(#n))?,),
+        }
+    });
+    let defaults = if specs.iter().all(|f| f.default.is_some()) {
+        let inits = specs.iter().map(|f| {
+            let id = &f.ident;
+            let d = default_value(f);
+            quote!(#id: #d,)
+        });
+        quote!(::core::option::Option::Some(#ty { #(#inits)* }))
+    } else {
+        quote!(::core::option::Option::None)
+    };
+    let expecting = format!("the parameters of `{name}`");
+    Ok(quote! {
+        impl #core::OperatorSpec for #ty {
+            const NAME: &'static str = #name;
+            const SUMMARY: &'static str = #summary;
+            const PARAMS: &'static [#core::Param] = &[#(#params),*];
+            type Op = #op;
+
+            fn build(self) -> ::core::result::Result<#op, #core::CovError> {
+                <#op as ::core::convert::TryFrom<#ty>>::try_from(self)
+            }
+
+            fn deserialize_in<'de, __D: #serde::Deserializer<'de>, __R: #core::OperatorReader>(
+                d: __D,
+                reader: &__R,
+            ) -> ::core::result::Result<Self, __D::Error> {
+                const FIELDS: &[&str] = &[#(#names),*];
+                struct __Visitor<'r, R>(&'r R);
+                impl<'de, 'r, R: #core::OperatorReader> #serde::de::Visitor<'de> for __Visitor<'r, R> {
+                    type Value = #ty;
+                    fn expecting(&self, f: &mut ::core::fmt::Formatter<'_>) -> ::core::fmt::Result {
+                        f.write_str(#expecting)
+                    }
+                    fn visit_map<__A: #serde::de::MapAccess<'de>>(self, mut __map: __A) -> ::core::result::Result<#ty, __A::Error> {
+                        #(#decls)*
+                        while let ::core::option::Option::Some(__key) =
+                            #serde::de::MapAccess::next_key_seed(&mut __map, #core::spec::FieldName)?
+                        {
+                            match __key.as_str() {
+                                #(#arms)*
+                                __other => {
+                                    return ::core::result::Result::Err(
+                                        <__A::Error as #serde::de::Error>::unknown_field(__other, FIELDS),
+                                    );
+                                }
+                            }
+                        }
+                        ::core::result::Result::Ok(#ty { #(#finish)* })
+                    }
+                }
+                #serde::Deserializer::deserialize_struct(d, #name, FIELDS, __Visitor(reader))
+            }
+
+            fn defaults() -> ::core::option::Option<Self> {
+                #defaults
+            }
+        }
+    })
+}

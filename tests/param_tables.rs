@@ -1,0 +1,68 @@
+//! Every operator crate's docs show its parameter table, generated from the specs
+//! (`#[derive(OperatorSpec)]`): a parameter is declared once, on its field, and the docs
+//! cannot drift from it. `COVTRACE_BLESS=1 cargo test --test param_tables` rewrites the
+//! tables after a spec changes.
+
+use covtrace::spec::Catalogue;
+
+const BEGIN: &str = "//! <!-- parameters: generated from the specs";
+const END: &str = "//! <!-- end of parameters -->";
+
+/// An operator crate's `spec::register`, for a catalogue.
+type Register = fn(&mut Catalogue);
+
+fn check(crate_dir: &str, register: Register) -> Result<(), String> {
+    let mut c = Catalogue::default();
+    register(&mut c);
+    let table: String = c.markdown().lines().map(|l| format!("//! {l}\n")).collect();
+    let path =
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join(format!("crates/{crate_dir}/src/lib.rs"));
+    let text = std::fs::read_to_string(&path).map_err(|e| format!("{}: {e}", path.display()))?;
+    let b = text
+        .find(BEGIN)
+        .ok_or(format!("{crate_dir}: no parameter table marker"))?;
+    let b = b + text[b..].find('\n').ok_or("marker line")? + 1;
+    let e = text[b..].find(END).ok_or(format!("{crate_dir}: no end marker"))? + b;
+    if text[b..e] == table {
+        return Ok(());
+    }
+    if std::env::var_os("COVTRACE_BLESS").is_some() {
+        let new = format!("{}{}{}", &text[..b], table, &text[e..]);
+        std::fs::write(&path, new).map_err(|e| e.to_string())?;
+        return Ok(());
+    }
+    Err(format!(
+        "{crate_dir}: the parameter table in src/lib.rs differs from the specs; run COVTRACE_BLESS=1 cargo test --test param_tables\nexpected:\n{table}"
+    ))
+}
+
+#[test]
+fn crate_docs_show_the_generated_parameter_tables() {
+    let crates: [(&str, Register); 10] = [
+        ("cov-travel", covtrace::travel::spec::register),
+        ("cov-occlusion", covtrace::occlusion::spec::register),
+        ("cov-projection", covtrace::projection::spec::register),
+        ("cov-curvature", covtrace::curvature::spec::register),
+        ("cov-brdf", covtrace::brdf::spec::register),
+        ("cov-refraction", covtrace::refraction::spec::register),
+        ("cov-motion", covtrace::motion::spec::register),
+        ("cov-defocus", covtrace::defocus::spec::register),
+        ("cov-sensor", covtrace::sensor::spec::register),
+        ("cov-media", covtrace::media::spec::register),
+    ];
+    let errors: Vec<String> = crates.iter().filter_map(|(d, r)| check(d, *r).err()).collect();
+    assert!(errors.is_empty(), "{}", errors.join("\n\n"));
+}
+
+#[test]
+fn every_parameter_is_documented_with_a_unit_or_a_reason_not_to() {
+    let mut c = Catalogue::default();
+    covtrace::register_all(&mut c);
+    assert!(c.entries.len() >= 25, "{} operators", c.entries.len());
+    for e in &c.entries {
+        assert!(!e.summary.is_empty(), "{}: summary", e.name);
+        for p in e.params {
+            assert!(!p.doc.is_empty(), "{}.{}: no doc comment", e.name, p.name);
+        }
+    }
+}
