@@ -15,6 +15,7 @@
 #![warn(missing_docs)]
 
 pub mod plot;
+pub mod render;
 pub mod report;
 
 use covtrace::path::Evaluation;

@@ -288,8 +288,9 @@ fn step_error(index: usize, op: &dyn Operator, e: CovError) -> CovError {
     }
 }
 
+/// Applies one step and checks its result. It does not restore Σ on error: a failing
+/// chain restores its start once ([`Chain`]'s `apply`), and `eval`/`trace` discard Σ.
 fn apply_step(index: usize, op: &dyn Operator, c: &mut dyn Spectrum) -> Result<(), CovError> {
-    let before = c.snapshot();
     let result = op.apply(c).and_then(|()| match c.first_non_finite() {
         None => Ok(()),
         Some((row, col, value)) => Err(CovError::Overflow {
@@ -299,11 +300,7 @@ fn apply_step(index: usize, op: &dyn Operator, c: &mut dyn Spectrum) -> Result<(
             value,
         }),
     });
-    if let Err(e) = result {
-        c.restore(&before);
-        return Err(step_error(index, op, e));
-    }
-    Ok(())
+    result.map_err(|e| step_error(index, op, e))
 }
 
 impl Operator for Chain {

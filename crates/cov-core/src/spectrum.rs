@@ -109,6 +109,18 @@ pub trait Spectrum: fmt::Debug {
     /// # Errors
     /// [`CovError::Overflow`] naming `op`; Σ is left unchanged.
     fn raw_add_window(&mut self, op: &str, p: &[usize], w: &Small) -> Result<(), CovError>;
+    /// Rule 2 on one axis, `Σ_ii += w` (`w ≥ 0`): the common window, kept apart from
+    /// [`Spectrum::raw_add_window`] because it is the hot path of every occluder.
+    ///
+    /// # Errors
+    /// [`CovError::Overflow`] naming `op`; Σ is left unchanged.
+    fn raw_add_variance(&mut self, op: &str, i: usize, w: f64) -> Result<(), CovError>;
+    /// Rule 3 along one axis `p` with lobe spectrum `s ≥ 0` (rule 4 is `s = 0`): the
+    /// common lobe and integration, kept apart from [`Spectrum::raw_lobe`] for speed.
+    ///
+    /// # Errors
+    /// [`CovError::Overflow`] naming `op`; Σ is left unchanged.
+    fn raw_lobe_1(&mut self, op: &str, p: usize, s: f64) -> Result<(), CovError>;
     /// Rule 3 along the distinct indices `p` with lobe spectrum `S` (symmetric PSD); rule
     /// 4 is `S = 0`.
     ///
@@ -257,9 +269,7 @@ pub trait Spectrum: fmt::Debug {
         if w == 0.0 {
             return Ok(());
         }
-        let mut m = [[0.0; MAX]; MAX];
-        m[0][0] = w;
-        self.raw_add_window("add_variance", &[i], &m)
+        self.raw_add_variance("add_variance", i, w)
     }
 
     /// Rule 2: `Σ' = Σ + W`, with `W` the spectrum covariance of the window on `axes`,
@@ -286,17 +296,14 @@ pub trait Spectrum: fmt::Debug {
     /// Missing or repeated axis, wrong size, `S` not finite/symmetric/PSD; overflow.
     #[inline]
     fn convolve(&mut self, axes: &[Axis], s: &[f64]) -> Result<(), CovError> {
+        if let ([axis], [s1]) = (axes, s) {
+            // One axis: S is a non-negative number; no eigen-check needed.
+            let p = self.index(*axis)?;
+            CovError::require_non_negative("convolve", "S", *s1)?;
+            return self.raw_lobe_1("convolve", p, *s1);
+        }
         let (idx, k) = resolve(self.dim(), "convolve", axes)?;
-        let sm = match (k, s) {
-            (1, [s1]) => {
-                // One axis: S is a non-negative number; no eigen-check needed.
-                CovError::require_non_negative("convolve", "S", *s1)?;
-                let mut m = [[0.0; MAX]; MAX];
-                m[0][0] = *s1;
-                m
-            }
-            _ => block_from_slice("convolve", "S", k, s)?,
-        };
+        let sm = block_from_slice("convolve", "S", k, s)?;
         self.raw_lobe("convolve", &idx[..k], &sm)
     }
 
@@ -310,6 +317,10 @@ pub trait Spectrum: fmt::Debug {
     /// Missing or repeated axis.
     #[inline]
     fn integrate(&mut self, axes: &[Axis]) -> Result<(), CovError> {
+        if let [axis] = axes {
+            let p = self.index(*axis)?;
+            return self.raw_lobe_1("integrate", p, 0.0);
+        }
         let (idx, k) = resolve(self.dim(), "integrate", axes)?;
         self.raw_lobe("integrate", &idx[..k], &[[0.0; MAX]; MAX])
     }

@@ -121,6 +121,34 @@ impl<const N: usize> Spectrum for Cov<N> {
     }
 
     #[inline]
+    fn raw_add_variance(&mut self, op: &str, i: usize, w: f64) -> Result<(), CovError> {
+        let v = self.get(i, i) + w;
+        if !v.is_finite() {
+            return Err(CovError::Overflow {
+                operator: op.into(),
+                row: i,
+                col: i,
+                value: v,
+            });
+        }
+        self.set(i, i, v);
+        Ok(())
+    }
+
+    #[inline]
+    fn raw_lobe_1(&mut self, op: &str, p: usize, s: f64) -> Result<(), CovError> {
+        if s == 0.0 {
+            // Integration (or a diffuse lobe): a Schur complement of finite entries with a
+            // guarded division only shrinks Σ; nothing can overflow.
+            self.lobe_product_1(p, 0.0);
+            return Ok(());
+        }
+        let old = *self;
+        self.lobe_product_1(p, s);
+        self.finish(op, old)
+    }
+
+    #[inline]
     fn raw_lobe(&mut self, op: &str, p: &[usize], s: &Small) -> Result<(), CovError> {
         let old = *self;
         if let [p1] = p {

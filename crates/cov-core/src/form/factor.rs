@@ -301,6 +301,20 @@ impl<const N: usize> Spectrum for CovFactor<N> {
         self.fold(op, m, N + k)
     }
 
+    /// A column `√w e_i` is appended and the factor folded back.
+    fn raw_add_variance(&mut self, op: &str, i: usize, w: f64) -> Result<(), CovError> {
+        let mut m = self.work();
+        m[i][N] = w.sqrt();
+        self.fold(op, m, N + 1)
+    }
+
+    /// Potter's update along one axis.
+    fn raw_lobe_1(&mut self, op: &str, p: usize, s: f64) -> Result<(), CovError> {
+        let mut new = self.l;
+        potter_axis(&mut new, p, s.max(0.0));
+        self.commit(op, new)
+    }
+
     /// Rule 3 by Potter's update per axis (diagonal `S`) or the array algorithm.
     fn raw_lobe(&mut self, op: &str, p: &[usize], s: &Small) -> Result<(), CovError> {
         self.lobe(op, p, s)

@@ -1,0 +1,411 @@
+//! The covariance pass: for each pixel, a few covariance paths (camera → first hit → a
+//! light), each turned into an operator chain of the library (light source, travel,
+//! blocker edge, reflection at the hit, motion, lens, shutter), evaluated, and reduced to
+//! the sensor's per-pixel decisions (cov-sensor). Paths are weighted by the radiance they
+//! carry, ignoring visibility, so a shadowed region keeps the frequency content of the
+//! light, blockers and surface around it.
+//!
+//! What a path sees, in light order:
+//!
+//! 1. the emitter as a Gaussian window of the light's size ([`crate::world::Light::window_std`]),
+//!    constant in angle and time, seen from the hit through `Unproject(cos_l)`;
+//! 2. travel to the hit, with a `BlockerEdge` where auxiliary shadow rays to other points
+//!    of the light are blocked (the distance from the path to the nearest blocker hit, at
+//!    the blocker's depth);
+//! 3. the reflection at the hit ([`SurfaceBounce`]: projection, curvature of the shape,
+//!    mirror symmetry, the material's lobe, the turn from the plane of incidence to the
+//!    plane of the outgoing ray, inverse curvature, inverse projection), inside `Moving`
+//!    when the shape moves;
+//! 4. travel to the camera, with a `Moving` `BlockerEdge` where auxiliary camera rays
+//!    around the pixel see a silhouette (a nearer surface or the background) in front of
+//!    or behind the hit: defocus and motion blur of edges;
+//! 5. the camera: its motion, the shutter window, the thin lens (or pinhole), and the
+//!    sensor's decisions (`Sensor::decisions`).
+//!
+//! The pass holds Σ in covariance form: chains are short (at most about 15 operators), where
+//! both forms agree to rounding.
+
+use cov_brdf::Lobe;
+use cov_core::{AnyCov, Chain, CovError, Form, Operator, Spectrum};
+use cov_curvature::Curvature;
+use cov_defocus::{Pinhole, ThinLens};
+use cov_motion::{CameraMotion, Moving, Shutter, ShutterShape};
+use cov_occlusion::BlockerEdge;
+use cov_projection::{Mirror, Project, RotateFrame, Unproject};
+use cov_sensor::{PixelDecisions, Sensor, SensorParams};
+use cov_travel::Travel;
+use glam::DVec3;
+use rand::Rng;
+
+use crate::geometry::Hit;
+use crate::trace::{luminance, spawn};
+use crate::world::World;
+
+/// Auxiliary shadow rays per covariance path (to find blockers near the path).
+pub const SHADOW_PROBES: usize = 4;
+/// Auxiliary camera rays per covariance path (to find silhouettes near the pixel).
+pub const EDGE_PROBES: usize = 4;
+
+/// Reflection at a surface point for any pair of incident and outgoing directions: the
+/// cov-brdf composite's steps, with the turn between the two planes of incidence.
+#[derive(Clone, Copy, Debug)]
+pub struct SurfaceBounce {
+    /// Projection of the incident ray (frame x in its plane of incidence).
+    pub project: Project,
+    /// The shape's curvature.
+    pub curvature: Curvature,
+    /// The material's lobe.
+    pub lobe: Lobe,
+    /// Angle from the incident to the outgoing plane of incidence, about the normal.
+    pub turn: f64,
+    /// Inverse projection to the outgoing ray (frame x in its plane of incidence).
+    pub unproject: Unproject,
+}
+
+impl Operator for SurfaceBounce {
+    fn apply(&self, cov: &mut dyn Spectrum) -> Result<(), CovError> {
+        self.project.apply(cov)?;
+        // Incident directions in the surface frame point back toward the light.
+        Mirror.apply(cov)?;
+        self.curvature.apply_oblique(cov, self.project.cos(), 1.0)?;
+        Mirror.apply(cov)?;
+        self.lobe.apply_to(cov)?;
+        RotateFrame::new(self.turn)?.apply(cov)?;
+        self.curvature.apply_oblique(cov, self.unproject.cos(), -1.0)?;
+        self.unproject.apply(cov)
+    }
+    fn requires(&self) -> cov_core::AxisSet {
+        cov_core::AxisSet::SPACE
+    }
+}
+
+/// A unit vector orthogonal to `d`, in the plane of `d` and `n` when they are not parallel:
+/// the frame `x` of a ray in its plane of incidence.
+pub fn frame_x(d: DVec3, n: DVec3) -> DVec3 {
+    let p = n - d * n.dot(d);
+    if p.length() > 1e-9 {
+        p.normalize()
+    } else {
+        crate::material::basis(d).0
+    }
+}
+
+/// The frame rotation about `d` that turns the frame x `from` into `to` (positive from x
+/// towards `y = d × x`).
+pub fn turn(d: DVec3, from: DVec3, to: DVec3) -> f64 {
+    let y = d.cross(from);
+    to.dot(y).atan2(to.dot(from))
+}
+
+/// The tangential velocity `v` seen in the frame `(x, d × x)` of a ray `d`.
+fn in_frame(v: DVec3, d: DVec3, x: DVec3) -> [f64; 2] {
+    [v.dot(x), v.dot(d.cross(x))]
+}
+
+/// The per-pixel prediction of the covariance pass.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct PixelCov {
+    /// Image-space Σ in (cycles/px)²: `xx, xy, yy` (weighted mean over the pixel's paths).
+    pub sigma: [f64; 3],
+    /// Samples per pixel over pixel × lens × time (weighted mean).
+    pub spp: f64,
+    /// Sum of the paths' weights (0: no path carried light).
+    pub weight: f64,
+}
+
+/// Everything the pass needs once per image.
+#[derive(Debug)]
+pub struct CovCamera {
+    sensor: Sensor,
+    end: Chain,
+    layout: usize,
+}
+
+impl CovCamera {
+    /// The camera end of every chain, and the sensor.
+    ///
+    /// # Errors
+    /// Camera parameters the operators reject (never for a scene that loaded).
+    pub fn new(world: &World) -> Result<CovCamera, CovError> {
+        let cam = &world.camera;
+        let d_s = cam.sensor_distance();
+        let time = world.has_motion;
+        let mut end = Chain::new();
+        if time && let Some((a, b)) = cam.shutter {
+            end.push(Shutter::new(b - a, ShutterShape::Box)?);
+        }
+        let aperture = (cam.lens_radius > 0.0).then_some(cam.lens_radius / 2.0);
+        match aperture {
+            Some(ap) => end.push(ThinLens::new(cam.focal_length, ap, cam.focus_distance)?),
+            None => end.push(Pinhole::new(d_s)?),
+        }
+        let sensor = Sensor::new(SensorParams {
+            width: cam.width,
+            fov_x: cam.fov_x,
+            distance: d_s,
+            aperture,
+            shutter: if time {
+                cam.shutter.map(|(a, b)| (b - a) / 12f64.sqrt())
+            } else {
+                None
+            },
+            ..SensorParams::default()
+        })?;
+        Ok(CovCamera {
+            sensor,
+            end,
+            layout: if time { 5 } else { 4 },
+        })
+    }
+
+    /// The layout the pass traces in (4, or 5 with motion).
+    pub fn layout(&self) -> usize {
+        self.layout
+    }
+
+    /// The sensor.
+    pub fn sensor(&self) -> &Sensor {
+        &self.sensor
+    }
+}
+
+/// The source Σ of a light window of std `s` (m), constant in angle and time.
+fn source(layout: usize, s: f64) -> Result<AnyCov, CovError> {
+    let inf = f64::INFINITY;
+    if layout == 5 {
+        AnyCov::gaussian(&[s, s, inf, inf, inf])
+    } else {
+        AnyCov::gaussian(&[s, s, inf, inf])
+    }
+}
+
+/// Traces one covariance path through the pixel point `(px, py)` at time uniform `ut`;
+/// returns the decisions and the path's weight, or `None` when the path sees nothing.
+pub fn trace_path<R: Rng>(
+    world: &World,
+    cc: &CovCamera,
+    px: f64,
+    py: f64,
+    ut: f64,
+    rng: &mut R,
+) -> Result<Option<(PixelDecisions, f64)>, CovError> {
+    let cam = &world.camera;
+    let ray = cam.ray(px, py, (0.5, 0.5), ut);
+    let time = ray.time;
+    let Some(hit) = world
+        .geometry
+        .intersect(ray.origin, ray.dir, time, 0.0, f64::INFINITY)
+    else {
+        return Ok(None);
+    };
+    let motion = cc.layout == 5;
+    let d_out = -ray.dir; // from the hit towards the camera
+    let mut chain = Chain::new();
+    let weight;
+    let start;
+    let x_out = frame_x(d_out, hit.n);
+    if let Some(li) = hit.light {
+        // A light seen directly: its window, seen at the angle of the camera ray.
+        let light = &world.lights[li as usize];
+        weight = luminance(light.radiance()).max(0.0) * if hit.front { 1.0 } else { 0.0 };
+        start = source(cc.layout, light.window_std())?;
+        chain.push(Unproject::new(hit.ng.dot(d_out).abs().clamp(1e-6, 1.0))?);
+    } else {
+        let n_l = world.lights.len();
+        let pick = ((rng.random::<f64>() * n_l as f64) as usize).min(n_l - 1);
+        let light = &world.lights[pick];
+        let ls = light.sample(hit.p, rng.random(), rng.random());
+        let mat = &world.materials[hit.material as usize];
+        let (cos_i, f) = ls.map_or((0.0, DVec3::ZERO), |ls| {
+            (hit.n.dot(ls.wi), mat.eval(hit.n, d_out, ls.wi))
+        });
+        if let (Some(ls), true) = (ls, cos_i > 0.0 && f != DVec3::ZERO) {
+            weight = luminance(f * ls.radiance) * cos_i * n_l as f64 / ls.pdf;
+            let d_in = -ls.wi; // from the light towards the hit
+            // 1. The emitter window, foreshortened towards the hit.
+            start = source(cc.layout, light.window_std())?;
+            let cos_l = ls.n.dot(ls.wi).abs().clamp(1e-6, 1.0);
+            let x_l = frame_x(d_in, ls.n);
+            let x_in = frame_x(d_in, hit.n);
+            chain.push(Unproject::new(cos_l)?);
+            chain.push(RotateFrame::new(turn(d_in, x_l, x_in))?);
+            // 2. Travel, with the nearest blocker near the path.
+            match nearest_blocker(world, &hit, light, ls.y, time, rng) {
+                Some((s_b, r_b)) => {
+                    chain.push(Travel::new(s_b)?);
+                    chain.push(BlockerEdge::new(r_b)?);
+                    chain.push(Travel::new((ls.dist - s_b).max(0.0))?);
+                }
+                None => chain.push(Travel::new(ls.dist)?),
+            }
+            // 3. The reflection, in the shape's frame when it moves.
+            let t_in = (x_in - hit.n * x_in.dot(hit.n)).normalize_or_zero();
+            let t_out = (x_out - hit.n * x_out.dot(hit.n)).normalize_or_zero();
+            let y_in = d_in.cross(x_in);
+            let bounce = SurfaceBounce {
+                project: Project::new(cos_i.clamp(1e-6, 1.0))?,
+                curvature: Curvature::isotropic(hit.curvature)?,
+                lobe: mat.lobe(),
+                turn: t_out.dot(y_in).atan2(t_out.dot(t_in)),
+                unproject: Unproject::new(hit.n.dot(d_out).clamp(1e-6, 1.0))?,
+            };
+            if motion && hit.velocity != DVec3::ZERO {
+                chain.push(Moving::new(
+                    in_frame(hit.velocity, d_out, x_out),
+                    [0.0, 0.0],
+                    Chain::new().with(bounce),
+                )?);
+            } else {
+                chain.push(bounce);
+            }
+        } else {
+            // The light sample does not reach this side: what the camera sees here is
+            // indirect light, taken as constant (Σ = 0) where it leaves the surface. The
+            // camera side (silhouettes, defocus, motion) still counts, with weight 0.
+            weight = 0.0;
+            start = AnyCov::zeros(cc.layout)?;
+        }
+    }
+    // 4. Travel to the camera, past the nearest silhouette.
+    let x_cam = frame_x(d_out, cam.right);
+    match nearest_silhouette(world, &hit, px, py, time, ut) {
+        Some(e) => {
+            chain.push(Travel::new((hit.t - e.depth).max(0.0))?);
+            let edge = BlockerEdge::new(e.radius)?;
+            if motion && e.velocity != DVec3::ZERO {
+                chain.push(Moving::new(
+                    in_frame(e.velocity, d_out, x_out),
+                    [0.0, 0.0],
+                    Chain::new().with(edge),
+                )?);
+            } else {
+                chain.push(edge);
+            }
+            chain.push(Travel::new(e.depth.min(hit.t))?);
+        }
+        None => chain.push(Travel::new(hit.t)?),
+    }
+    chain.push(RotateFrame::new(turn(d_out, x_out, x_cam))?);
+    // 5. The camera.
+    if motion && cam.velocity != DVec3::ZERO {
+        chain.push(CameraMotion::new(
+            in_frame(cam.velocity, d_out, x_cam),
+            [0.0, 0.0],
+        )?);
+    }
+    let at_lens = chain.eval_any(Form::Covariance, &start)?;
+    let at_sensor = cc.end.eval_any(Form::Covariance, &at_lens)?;
+    let d = cc.sensor.decisions(at_sensor)?;
+    if !(weight.is_finite() && weight >= 0.0) {
+        return Ok(None);
+    }
+    Ok(Some((d, weight)))
+}
+
+/// The nearest blocker near the path from the light point `y` to the hit: auxiliary
+/// shadow rays to other points of the light; among the blocked ones, the blocker hit
+/// nearest to the path's segment. Returns (distance from the light along the path,
+/// distance from the path).
+fn nearest_blocker<R: Rng>(
+    world: &World,
+    hit: &Hit,
+    light: &crate::world::Light,
+    y: DVec3,
+    time: f64,
+    rng: &mut R,
+) -> Option<(f64, f64)> {
+    let seg = hit.p - y;
+    let len = seg.length();
+    if len <= 0.0 {
+        return None;
+    }
+    let dir = seg / len;
+    let mut best: Option<(f64, f64)> = None;
+    for k in 0..=SHADOW_PROBES {
+        // The path's own shadow ray first, then probes to other points of the light.
+        let target = if k == 0 {
+            y
+        } else {
+            match light.sample(hit.p, rng.random(), rng.random()) {
+                Some(s) => s.y,
+                None => continue,
+            }
+        };
+        let d = target - hit.p;
+        let dist = d.length();
+        if dist <= 0.0 {
+            continue;
+        }
+        let wi = d / dist;
+        let o = spawn(hit, wi);
+        if let Some(b) = world.geometry.intersect(o, wi, time, 0.0, dist * (1.0 - 1e-6)) {
+            // The blocker point relative to the path: its depth from the light, and its
+            // distance from the path's line.
+            let rel = b.p - y;
+            let along = rel.dot(dir).clamp(0.0, len);
+            let r = (rel - dir * rel.dot(dir)).length().max(1e-6 * len);
+            if best.is_none_or(|(_, br)| r < br) {
+                best = Some((along, r));
+            }
+        }
+    }
+    best
+}
+
+/// Relative depth difference that makes a silhouette.
+pub const DEPTH_JUMP: f64 = 0.05;
+/// Cosine of the normal turn that makes a crease (25°).
+pub const CREASE_COS: f64 = 0.906;
+
+/// A silhouette near a pixel's path.
+struct Silhouette {
+    /// Distance from the camera to the edge's surface (m).
+    depth: f64,
+    /// Distance from the path to the edge at that depth (m).
+    radius: f64,
+    /// Velocity of the nearer surface.
+    velocity: DVec3,
+}
+
+/// An edge around the pixel: auxiliary pinhole rays half a pixel away that see something
+/// else, a surface at a clearly different depth (more than [`DEPTH_JUMP`] relative) or
+/// nothing (a silhouette), a surface turned by more than `acos(`[`CREASE_COS`]`)` (a
+/// crease, where shading changes abruptly), or an emitter where the path sees none (the
+/// edge of a light) or the reverse. The edge lies at the nearer surface's depth, at the
+/// probe's distance from the path there.
+fn nearest_silhouette(world: &World, hit: &Hit, px: f64, py: f64, time: f64, ut: f64) -> Option<Silhouette> {
+    let cam = &world.camera;
+    let mut best: Option<Silhouette> = None;
+    let offsets = [(0.5, 0.0), (-0.5, 0.0), (0.0, 0.5), (0.0, -0.5)];
+    for &(dx, dy) in offsets.iter().take(EDGE_PROBES) {
+        let r = cam.ray(px + dx, py + dy, (0.5, 0.5), ut);
+        let h = world
+            .geometry
+            .intersect(r.origin, r.dir, time, 0.0, f64::INFINITY);
+        let (depth, vel) = match h {
+            Some(h2)
+                if (h2.t - hit.t).abs() <= DEPTH_JUMP * hit.t
+                    && h2.n.dot(hit.n) >= CREASE_COS
+                    && h2.light.is_some() == hit.light.is_some() =>
+            {
+                continue;
+            }
+            Some(h2) => (
+                h2.t.min(hit.t),
+                if h2.t < hit.t { h2.velocity } else { hit.velocity },
+            ),
+            None => (hit.t, hit.velocity),
+        };
+        // Distance between the two camera rays at that depth: half a pixel's footprint.
+        let pitch = 2.0 * cam.tan_x * depth / cam.width as f64;
+        let radius = (pitch * (dx.abs() + dy.abs())).max(1e-9);
+        if best.as_ref().is_none_or(|b| radius < b.radius) {
+            best = Some(Silhouette {
+                depth,
+                radius,
+                velocity: vel,
+            });
+        }
+    }
+    best
+}

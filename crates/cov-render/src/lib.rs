@@ -1,0 +1,51 @@
+//! # cov-render: a renderer driven by covariance tracing
+//!
+//! A CPU path tracer (area lights with soft shadows, one indirect bounce, defocus over a
+//! thin lens, motion blur over the shutter) whose scenes are RON files ([`scene`]), and a
+//! **covariance pass** ([`covpass`]) that builds, for each pixel, the operator chains of
+//! the covtrace library along a few camera paths and reduces them to the sensor's
+//! decisions: how many samples the pixel needs over pixel × lens × time, and how wide its
+//! reconstruction filter may be. The renderer never re-derives an operator's formula: it
+//! only chooses the operators and their parameters from what the rays hit.
+//!
+//! ```no_run
+//! use cov_render::{World, covariance_maps, render};
+//!
+//! let world = World::load(std::path::Path::new("examples/scenes/cornell.ron"))?;
+//! let image = render(&world, 16, 1); // 16 samples per pixel, seed 1
+//! let maps = covariance_maps(&world, 4, 1)?; // 4 covariance paths per pixel
+//! println!("{} px, predicted {:.1} spp at the centre", image.pixels.len(),
+//!     maps.pixels[maps.pixels.len() / 2].spp);
+//! # Ok::<(), Box<dyn std::error::Error>>(())
+//! ```
+//!
+//! Determinism: tiles draw from generators seeded by the scene seed and the tile index,
+//! so an image is the same on any number of threads.
+
+#![warn(missing_docs)]
+
+pub mod covpass;
+pub mod geometry;
+pub mod material;
+pub mod render;
+pub mod scene;
+pub mod trace;
+pub mod validate;
+pub mod world;
+
+pub use render::{CovMaps, Image, MAX_COV_PATHS, MAX_SPP, covariance_maps, render, render_adaptive};
+pub use scene::SceneError;
+pub use world::World;
+
+/// Longest piece of user input echoed in a message (characters).
+pub const ECHO_MAX: usize = 64;
+
+/// `s`, cut to [`ECHO_MAX`] characters with `…` when longer.
+pub fn echo(s: &str) -> String {
+    if s.chars().count() <= ECHO_MAX {
+        s.to_string()
+    } else {
+        let cut: String = s.chars().take(ECHO_MAX).collect();
+        format!("{cut}… ({} characters)", s.chars().count())
+    }
+}

@@ -1,0 +1,346 @@
+//! Scene files in RON: the description a user writes, checked where it is written.
+//!
+//! ```ron
+//! Scene(
+//!     camera: (
+//!         position: (0.0, 1.0, 4.0), look_at: (0.0, 1.0, 0.0),
+//!         fov: 40.0,                       // horizontal, degrees
+//!         width: 160, height: 120,
+//!         lens: Some((aperture: 0.03, focus_distance: 4.0)),   // left out: a pinhole
+//!         shutter: Some((open: 0.0, close: 0.02)),             // left out: no time axis
+//!     ),
+//!     materials: { "white": Diffuse(albedo: (0.7, 0.7, 0.7)) },
+//!     lights: [Rect(corner: (-0.3, 1.99, -0.3), edge_u: (0.6, 0.0, 0.0), edge_v: (0.0, 0.0, 0.6), radiance: (15.0, 15.0, 15.0))],
+//!     shapes: [Sphere(center: (0.0, 0.5, 0.0), radius: 0.5, material: "white", velocity: Some((0.5, 0.0, 0.0)))],
+//! )
+//! ```
+//!
+//! Every number is checked as it is read (finite, in range), so a bad value is reported
+//! at its own line and column; names that refer elsewhere (a material, an OBJ file) are
+//! checked after reading and reported where they are written.
+//!
+//! | field | unit | meaning |
+//! |---|---|---|
+//! | `camera.position`, `look_at`, `up` | m | pinhole / lens centre, aim point, up vector (default +y) |
+//! | `camera.fov` | degrees | horizontal field of view, in (0, 180) |
+//! | `camera.width`, `height` | px | 1 to [`MAX_RESOLUTION`] each |
+//! | `camera.lens.aperture` | m | lens radius (0: pinhole) |
+//! | `camera.lens.focus_distance` | m | distance of the plane in focus, > 0 |
+//! | `camera.lens.focal_length` | m | focal length (default 0.05), < focus distance |
+//! | `camera.shutter.open`, `close` | s | shutter interval, `close > open` |
+//! | `camera.velocity` | m/s | camera motion during the shutter |
+//! | `materials` | | named `Diffuse(albedo)`, `Phong(albedo, exponent)`, `Ggx(albedo, alpha)` |
+//! | `lights` | | `Rect(corner, edge_u, edge_v, radiance)`, `Sphere(center, radius, radiance)`; radiance in W/(m² sr) per channel |
+//! | `shapes` | | `Sphere(center, radius, material, velocity)`, `Quad(corner, edge_u, edge_v, material, velocity)`, `Mesh(obj, material, translate, scale, velocity)` |
+
+use std::collections::BTreeMap;
+use std::fmt;
+
+use serde::Deserialize;
+use serde::de::{Deserializer, Error as _};
+
+/// Largest image side (px): bounds memory (a float RGB image of 8192² is 800 MB).
+pub const MAX_RESOLUTION: u32 = 8192;
+/// Largest scene file read (bytes).
+pub const MAX_SCENE_BYTES: u64 = 16 << 20;
+/// Largest number of triangles over all meshes of a scene.
+pub const MAX_TRIANGLES: usize = 5_000_000;
+
+/// An error in a scene file, in one line: `file:line:col: message`.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+#[error("{file}:{}{message}", at.map(|(l, c)| format!("{l}:{c}: ")).unwrap_or_else(|| " ".into()))]
+pub struct SceneError {
+    /// The scene file.
+    pub file: String,
+    /// Line and column, when known.
+    pub at: Option<(usize, usize)>,
+    /// What is wrong.
+    pub message: String,
+}
+
+/// Defines a checked number type: `$name(f64)` deserialised and validated at once, so a
+/// bad value is reported where it is written.
+macro_rules! checked {
+    ($(#[$m:meta])* $name:ident, $ok:expr, $what:literal) => {
+        $(#[$m])*
+        #[derive(Clone, Copy, Debug, PartialEq)]
+        pub struct $name(pub f64);
+        impl<'de> Deserialize<'de> for $name {
+            fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+                let v = f64::deserialize(d)?;
+                let ok: fn(f64) -> bool = $ok;
+                if ok(v) { Ok($name(v)) } else { Err(D::Error::custom(format!(concat!("must be ", $what, ", got {}"), v))) }
+            }
+        }
+    };
+}
+
+checked!(
+    /// A finite number.
+    Finite, f64::is_finite, "finite"
+);
+checked!(
+    /// A finite number > 0.
+    Positive, |v| v.is_finite() && v > 0.0, "finite and > 0"
+);
+checked!(
+    /// A finite number ≥ 0.
+    NonNegative, |v| v.is_finite() && v >= 0.0, "finite and ≥ 0"
+);
+
+/// A point or vector `(x, y, z)`, finite.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct V3(pub [f64; 3]);
+
+impl<'de> Deserialize<'de> for V3 {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        let v = <(f64, f64, f64)>::deserialize(d)?;
+        let a = [v.0, v.1, v.2];
+        if a.iter().all(|x| x.is_finite()) {
+            Ok(V3(a))
+        } else {
+            Err(D::Error::custom(format!(
+                "a vector must be finite, got ({}, {}, {})",
+                v.0, v.1, v.2
+            )))
+        }
+    }
+}
+
+/// A colour `(r, g, b)`, finite and ≥ 0.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Rgb(pub [f64; 3]);
+
+impl<'de> Deserialize<'de> for Rgb {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        let v = <(f64, f64, f64)>::deserialize(d)?;
+        let a = [v.0, v.1, v.2];
+        if a.iter().all(|x| x.is_finite() && *x >= 0.0) {
+            Ok(Rgb(a))
+        } else {
+            Err(D::Error::custom(format!(
+                "a colour must be finite and ≥ 0, got ({}, {}, {})",
+                v.0, v.1, v.2
+            )))
+        }
+    }
+}
+
+/// An image side in pixels, 1 to [`MAX_RESOLUTION`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Resolution(pub u32);
+
+impl<'de> Deserialize<'de> for Resolution {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        let v = u64::deserialize(d)?;
+        if (1..=MAX_RESOLUTION as u64).contains(&v) {
+            Ok(Resolution(v as u32))
+        } else {
+            Err(D::Error::custom(format!(
+                "must be 1 to {MAX_RESOLUTION} px, got {v}"
+            )))
+        }
+    }
+}
+
+/// The whole file, written `Scene(...)`.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields, rename = "Scene")]
+pub struct SceneFile {
+    /// The camera.
+    pub camera: CameraDesc,
+    /// Named materials.
+    #[serde(default)]
+    pub materials: BTreeMap<String, MaterialDesc>,
+    /// Emitters.
+    pub lights: Vec<LightDesc>,
+    /// Geometry.
+    pub shapes: Vec<ShapeDesc>,
+}
+
+/// The camera.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CameraDesc {
+    /// Centre of the lens (m).
+    pub position: V3,
+    /// Point aimed at (m).
+    pub look_at: V3,
+    /// Up vector (default +y).
+    #[serde(default)]
+    pub up: Option<V3>,
+    /// Horizontal field of view (degrees).
+    pub fov: Positive,
+    /// Image width (px).
+    pub width: Resolution,
+    /// Image height (px).
+    pub height: Resolution,
+    /// A thin lens; none: a pinhole.
+    #[serde(default)]
+    pub lens: Option<LensDesc>,
+    /// The shutter interval; none: a still image (no time axis).
+    #[serde(default)]
+    pub shutter: Option<ShutterDesc>,
+    /// Camera velocity during the shutter (m/s).
+    #[serde(default)]
+    pub velocity: Option<V3>,
+}
+
+/// A thin lens.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct LensDesc {
+    /// Lens radius (m); 0 is a pinhole.
+    pub aperture: NonNegative,
+    /// Distance in focus (m).
+    pub focus_distance: Positive,
+    /// Focal length (m), default 0.05.
+    #[serde(default)]
+    pub focal_length: Option<Positive>,
+}
+
+/// The shutter interval (s).
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ShutterDesc {
+    /// Opening time.
+    pub open: Finite,
+    /// Closing time (> open).
+    pub close: Finite,
+}
+
+/// A material.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub enum MaterialDesc {
+    /// Lambertian.
+    Diffuse {
+        /// Reflectance per channel, ≤ 1.
+        albedo: Rgb,
+    },
+    /// Normalised modified Phong around the mirror direction (the cov-brdf Phong lobe).
+    Phong {
+        /// Reflectance per channel.
+        albedo: Rgb,
+        /// Exponent ≥ 0.
+        exponent: NonNegative,
+    },
+    /// GGX microfacets (the cov-brdf GGX lobe).
+    Ggx {
+        /// Reflectance per channel.
+        albedo: Rgb,
+        /// Roughness > 0.
+        alpha: Positive,
+    },
+}
+
+/// An area light.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub enum LightDesc {
+    /// A parallelogram emitting on the side of `edge_u × edge_v`.
+    Rect {
+        /// A corner (m).
+        corner: V3,
+        /// First edge (m).
+        edge_u: V3,
+        /// Second edge (m).
+        edge_v: V3,
+        /// Radiance.
+        radiance: Rgb,
+    },
+    /// A sphere emitting outwards.
+    Sphere {
+        /// Centre (m).
+        center: V3,
+        /// Radius (m).
+        radius: Positive,
+        /// Radiance.
+        radiance: Rgb,
+    },
+}
+
+/// A shape.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub enum ShapeDesc {
+    /// A sphere.
+    Sphere {
+        /// Centre at time 0 (m).
+        center: V3,
+        /// Radius (m).
+        radius: Positive,
+        /// Material name.
+        material: String,
+        /// Velocity (m/s).
+        #[serde(default)]
+        velocity: Option<V3>,
+    },
+    /// A parallelogram.
+    Quad {
+        /// A corner (m).
+        corner: V3,
+        /// First edge (m).
+        edge_u: V3,
+        /// Second edge (m).
+        edge_v: V3,
+        /// Material name.
+        material: String,
+        /// Velocity (m/s).
+        #[serde(default)]
+        velocity: Option<V3>,
+    },
+    /// A triangle mesh from an OBJ file (path relative to the scene file).
+    Mesh {
+        /// The OBJ file.
+        obj: String,
+        /// Material name.
+        material: String,
+        /// Translation (m), applied after scaling.
+        #[serde(default)]
+        translate: Option<V3>,
+        /// Uniform scale.
+        #[serde(default)]
+        scale: Option<Positive>,
+        /// Velocity (m/s).
+        #[serde(default)]
+        velocity: Option<V3>,
+    },
+}
+
+/// Line and column (1-based) of the first occurrence of `needle` in `text`.
+pub(crate) fn position_of(text: &str, needle: &str) -> Option<(usize, usize)> {
+    let at = text.find(needle)?;
+    let before = &text[..at];
+    let line = before.matches('\n').count() + 1;
+    let col = before.rsplit('\n').next().map_or(0, |l| l.chars().count()) + 1;
+    Some((line, col))
+}
+
+impl SceneFile {
+    /// Parses scene text; `file` names it in errors.
+    ///
+    /// # Errors
+    /// Malformed RON, unknown fields or variants, bad numbers: positioned.
+    pub fn parse(text: &str, file: &str) -> Result<SceneFile, SceneError> {
+        let text = text.strip_prefix('\u{feff}').unwrap_or(text);
+        ron::Options::default()
+            .with_default_extension(ron::extensions::Extensions::IMPLICIT_SOME)
+            .from_str(text)
+            .map_err(|e| SceneError {
+                file: file.to_string(),
+                at: Some((e.span.start.line, e.span.start.col)),
+                message: e.code.to_string(),
+            })
+    }
+}
+
+impl fmt::Display for MaterialDesc {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            MaterialDesc::Diffuse { .. } => f.write_str("Diffuse"),
+            MaterialDesc::Phong { .. } => f.write_str("Phong"),
+            MaterialDesc::Ggx { .. } => f.write_str("Ggx"),
+        }
+    }
+}

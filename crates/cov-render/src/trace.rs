@@ -1,0 +1,109 @@
+//! The path tracer: direct lighting from area lights (light and BRDF sampling combined by
+//! multiple importance sampling) and one indirect bounce (with light sampling at the
+//! second vertex), over pixel × lens × time.
+//!
+//! The estimator is unbiased for the transport it includes: paths of one and two bounces
+//! (camera → x₁ → light, camera → x₁ → x₂ → light) and lights seen directly.
+
+use glam::DVec3;
+use rand::Rng;
+
+use crate::geometry::Hit;
+use crate::world::{CameraRay, World};
+
+/// Offset of a spawned ray from its surface, relative to the scene's scale of the point.
+const SPAWN_EPS: f64 = 1e-7;
+
+/// A ray origin just off the surface at `hit`, on the side of `dir`.
+pub fn spawn(hit: &Hit, dir: DVec3) -> DVec3 {
+    let eps = SPAWN_EPS * (1.0 + hit.p.abs().max_element());
+    let side = if dir.dot(hit.ng) >= 0.0 { 1.0 } else { -1.0 };
+    hit.p + hit.ng * (eps * side)
+}
+
+/// Luminance (Rec. 709 weights).
+pub fn luminance(c: DVec3) -> f64 {
+    0.2126 * c.x + 0.7152 * c.y + 0.0722 * c.z
+}
+
+/// The radiance a light leaves towards `-dir` at `hit` (one-sided emitters).
+fn emitted(world: &World, hit: &Hit) -> DVec3 {
+    match hit.light {
+        Some(l) if hit.front => world.lights[l as usize].radiance(),
+        _ => DVec3::ZERO,
+    }
+}
+
+/// Light sampling at a surface hit; with `mis`, weighted against BRDF sampling.
+fn direct<R: Rng>(world: &World, hit: &Hit, wo: DVec3, time: f64, rng: &mut R, mis: bool) -> DVec3 {
+    let n_lights = world.lights.len();
+    let pick = (rng.random::<f64>() * n_lights as f64) as usize;
+    let light = &world.lights[pick.min(n_lights - 1)];
+    let Some(ls) = light.sample(hit.p, rng.random(), rng.random()) else {
+        return DVec3::ZERO;
+    };
+    let mat = &world.materials[hit.material as usize];
+    let f = mat.eval(hit.n, wo, ls.wi);
+    let cos = hit.n.dot(ls.wi);
+    if f == DVec3::ZERO || cos <= 0.0 || ls.wi.dot(hit.ng) <= 0.0 {
+        return DVec3::ZERO;
+    }
+    let o = spawn(hit, ls.wi);
+    if world
+        .geometry
+        .occluded(o, ls.wi, time, 0.0, ls.dist * (1.0 - 1e-6))
+    {
+        return DVec3::ZERO;
+    }
+    let pl = ls.pdf / n_lights as f64;
+    let w = if mis {
+        let pb = mat.pdf(hit.n, wo, ls.wi);
+        pl * pl / (pl * pl + pb * pb)
+    } else {
+        1.0
+    };
+    f * ls.radiance * (cos * w / pl)
+}
+
+/// The radiance arriving along a camera ray (one sample of the estimator).
+pub fn radiance<R: Rng>(world: &World, ray: &CameraRay, rng: &mut R) -> DVec3 {
+    let Some(hit) = world
+        .geometry
+        .intersect(ray.origin, ray.dir, ray.time, 0.0, f64::INFINITY)
+    else {
+        return DVec3::ZERO;
+    };
+    if hit.light.is_some() {
+        return emitted(world, &hit);
+    }
+    let wo = -ray.dir;
+    let mut l = direct(world, &hit, wo, ray.time, rng, true);
+    // One indirect bounce, by BRDF sampling.
+    let mat = &world.materials[hit.material as usize];
+    let Some(wi) = mat.sample(hit.n, wo, rng.random(), rng.random()) else {
+        return l;
+    };
+    let pb = mat.pdf(hit.n, wo, wi);
+    let cos = hit.n.dot(wi);
+    if pb <= 0.0 || cos <= 0.0 || wi.dot(hit.ng) <= 0.0 {
+        return l;
+    }
+    let throughput = mat.eval(hit.n, wo, wi) * (cos / pb);
+    let o = spawn(&hit, wi);
+    let Some(h2) = world.geometry.intersect(o, wi, ray.time, 0.0, f64::INFINITY) else {
+        return l;
+    };
+    match h2.light {
+        Some(li) => {
+            // A light found by BRDF sampling: the other half of the MIS pair.
+            let le = emitted(world, &h2);
+            if le != DVec3::ZERO {
+                let light = &world.lights[li as usize];
+                let pl = light.pdf(hit.p, wi, h2.t, h2.n) / world.lights.len() as f64;
+                l += throughput * le * (pb * pb / (pb * pb + pl * pl));
+            }
+        }
+        None => l += throughput * direct(world, &h2, -wi, ray.time, rng, false),
+    }
+    l
+}

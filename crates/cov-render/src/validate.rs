@@ -1,0 +1,260 @@
+//! Predictions against images: the local spectrum of a reference image, tile by tile,
+//! compared with the covariance pass's prediction.
+//!
+//! For each tile of `T × T` pixels of two independent references (same scene, other
+//! seeds): subtract the tile mean, multiply by a Hann window, FFT (rustfft), and take the
+//! **cross** power spectrum `Re(F_a · conj F_b)`: the two renders' Monte Carlo noise is
+//! independent, so its expectation is the image's own power spectrum with no noise term
+//! (fireflies included). The measured image-space Σ is twice the normalised second moment
+//! of that power spectrum, less the Hann window's own: for a Gaussian the amplitude
+//! spectrum's Σ (PHYSICS.md §1) is exactly twice the power spectrum's, and the power
+//! moment is linear in the cross-spectrum, so noise cancels in expectation (the amplitude
+//! `√cross` of single noisy bins would not: it is biased upwards). The predicted Σ is the mean of the covariance pass's per-pixel Σ over the
+//! tile, minus the pixel filter's own window (the sensor adds `1/(4π² f²)` per axis for a
+//! filter of std `f` px), so that both describe the image's content.
+//!
+//! Bandwidths are `√tr Σ` (cycles/px); predictions are capped at [`NYQUIST_CAP`], the
+//! most an image can show. A tile **has detail** when its luminance std is at least
+//! [`DETAIL`] of the image's mean luminance, its signal power stands above its noise power
+//! (estimated from the difference of the two references), and its measured bandwidth is
+//! above [`RESOLVED`], what a `T`-pixel tile resolves beyond its first frequency bins (a
+//! smooth gradient is not detail). A tile is **under-sampled** when the predicted bandwidth
+//! is below half the measured one: the prediction would give it too few samples.
+
+use std::f64::consts::PI;
+
+use rustfft::FftPlanner;
+use rustfft::num_complex::Complex;
+
+use crate::render::{CovMaps, Image};
+use crate::trace::luminance;
+
+/// Tile side (px) of the comparison.
+pub const T: usize = 16;
+/// A tile has detail when its luminance std is at least this fraction of the image mean.
+pub const DETAIL: f64 = 0.02;
+/// Bandwidth a tile resolves beyond its first bins, `2/T` cycles/px.
+pub const RESOLVED: f64 = 2.0 / T as f64;
+/// The largest bandwidth an image of box-filtered pixels can show, `√(2·0.5²)` cycles/px.
+pub const NYQUIST_CAP: f64 = std::f64::consts::FRAC_1_SQRT_2;
+
+/// One tile's comparison.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
+pub struct TileCheck {
+    /// Tile column and row.
+    pub tile: (usize, usize),
+    /// Predicted bandwidth of the content (cycles/px).
+    pub predicted: f64,
+    /// Measured bandwidth (cycles/px).
+    pub measured: f64,
+    /// Whether the tile has detail.
+    pub detail: bool,
+}
+
+/// The comparison over an image.
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+pub struct Agreement {
+    /// Every tile.
+    pub tiles: Vec<TileCheck>,
+    /// Tiles with detail.
+    pub detail_tiles: usize,
+    /// Median of predicted/measured over tiles with detail.
+    pub median_ratio: f64,
+    /// Spearman rank correlation of predicted and measured over tiles with detail.
+    pub rank_correlation: f64,
+    /// Fraction of tiles with detail whose prediction is below half the measurement.
+    pub undersampled: f64,
+}
+
+/// The Hann window of `T` points.
+fn hann() -> [f64; T] {
+    let mut w = [0.0; T];
+    for (i, v) in w.iter_mut().enumerate() {
+        *v = 0.5 - 0.5 * (2.0 * PI * (i as f64 + 0.5) / T as f64).cos();
+    }
+    w
+}
+
+/// Frequency of FFT bin `k` (cycles/px), in `[-1/2, 1/2)`.
+fn freq(k: usize) -> f64 {
+    let k = k as f64;
+    if k < T as f64 / 2.0 {
+        k / T as f64
+    } else {
+        (k - T as f64) / T as f64
+    }
+}
+
+/// The 2D spectrum of a `T × T` tile (row-major).
+fn spectrum(tile: &[f64]) -> Vec<Complex<f64>> {
+    let mut planner = FftPlanner::<f64>::new();
+    let fft = planner.plan_fft_forward(T);
+    let mut buf: Vec<Complex<f64>> = tile.iter().map(|&v| Complex::new(v, 0.0)).collect();
+    for row in buf.chunks_exact_mut(T) {
+        fft.process(row);
+    }
+    let mut col = vec![Complex::new(0.0, 0.0); T];
+    for x in 0..T {
+        for y in 0..T {
+            col[y] = buf[y * T + x];
+        }
+        fft.process(&mut col);
+        for y in 0..T {
+            buf[y * T + x] = col[y];
+        }
+    }
+    buf
+}
+
+/// The normalised second moment `tr Σ` of a spectrum (amplitude or power; DC excluded).
+fn second_moment(amp: &[f64]) -> Option<f64> {
+    let (mut s, mut m) = (0.0, 0.0);
+    for ky in 0..T {
+        for kx in 0..T {
+            if kx == 0 && ky == 0 {
+                continue;
+            }
+            let a = amp[ky * T + kx];
+            let (fx, fy) = (freq(kx), freq(ky));
+            s += a;
+            m += a * (fx * fx + fy * fy);
+        }
+    }
+    (s > 0.0).then(|| m / s)
+}
+
+/// Ranks (average ranks for ties) of `v`.
+fn ranks(v: &[f64]) -> Vec<f64> {
+    let mut idx: Vec<usize> = (0..v.len()).collect();
+    idx.sort_by(|&a, &b| v[a].total_cmp(&v[b]));
+    let mut r = vec![0.0; v.len()];
+    let mut i = 0;
+    while i < idx.len() {
+        let mut j = i;
+        while j + 1 < idx.len() && v[idx[j + 1]] == v[idx[i]] {
+            j += 1;
+        }
+        for k in i..=j {
+            r[idx[k]] = (i + j) as f64 / 2.0;
+        }
+        i = j + 1;
+    }
+    r
+}
+
+/// Spearman's rank correlation (0 when undefined).
+pub fn spearman(a: &[f64], b: &[f64]) -> f64 {
+    let n = a.len().min(b.len());
+    if n < 2 {
+        return 0.0;
+    }
+    let (ra, rb) = (ranks(&a[..n]), ranks(&b[..n]));
+    let ma = ra.iter().sum::<f64>() / n as f64;
+    let mb = rb.iter().sum::<f64>() / n as f64;
+    let (mut c, mut va, mut vb) = (0.0, 0.0, 0.0);
+    for i in 0..n {
+        c += (ra[i] - ma) * (rb[i] - mb);
+        va += (ra[i] - ma).powi(2);
+        vb += (rb[i] - mb).powi(2);
+    }
+    if va <= 0.0 || vb <= 0.0 {
+        0.0
+    } else {
+        c / (va * vb).sqrt()
+    }
+}
+
+/// Compares the covariance pass's `maps` with two independent renders `a`, `b` of the same
+/// scene (other seeds, same sample counts); `pixel_filter` is the sensor's filter std (px).
+pub fn compare(a: &Image, b: &Image, maps: &CovMaps, pixel_filter: f64) -> Agreement {
+    let (w, h) = (a.width as usize, a.height as usize);
+    let win = hann();
+    // The window's own second moment (its amplitude spectrum alone).
+    let mut wtile = vec![0.0; T * T];
+    for y in 0..T {
+        for x in 0..T {
+            wtile[y * T + x] = win[x] * win[y];
+        }
+    }
+    let wpow: Vec<f64> = spectrum(&wtile).iter().map(|c| c.norm_sqr()).collect();
+    let own = second_moment(&wpow).unwrap_or(0.0);
+    let n_px = a.pixels.len().max(1) as f64;
+    let mean_l = a
+        .pixels
+        .iter()
+        .zip(&b.pixels)
+        .map(|(p, q)| 0.5 * (luminance(*p) + luminance(*q)))
+        .sum::<f64>()
+        / n_px;
+    let px_window = 1.0 / (4.0 * PI * PI * pixel_filter * pixel_filter);
+    let windowed = |img: &Image, tx: usize, ty: usize| -> (Vec<f64>, f64) {
+        let mut lum = vec![0.0; T * T];
+        for y in 0..T {
+            for x in 0..T {
+                lum[y * T + x] = luminance(img.pixels[(ty * T + y) * w + tx * T + x]);
+            }
+        }
+        let mean = lum.iter().sum::<f64>() / (T * T) as f64;
+        let std = (lum.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / (T * T) as f64).sqrt();
+        let out = lum
+            .iter()
+            .enumerate()
+            .map(|(k, v)| (v - mean) * win[k % T] * win[k / T])
+            .collect();
+        (out, std)
+    };
+    let mut tiles = Vec::new();
+    for ty in 0..h / T {
+        for tx in 0..w / T {
+            let (wa, sa) = windowed(a, tx, ty);
+            let (wb, sb) = windowed(b, tx, ty);
+            let (fa, fb) = (spectrum(&wa), spectrum(&wb));
+            let cross: Vec<f64> = fa.iter().zip(&fb).map(|(p, q)| (p * q.conj()).re).collect();
+            // Noise power from the difference of the two renders: E|F_a − F_b|² = 2 N.
+            let noise: f64 = fa.iter().zip(&fb).map(|(p, q)| (p - q).norm_sqr()).sum::<f64>() / 2.0;
+            let signal: f64 = cross.iter().sum::<f64>();
+            let measured = second_moment(&cross).map_or(0.0, |m| (2.0 * (m - own)).max(0.0).sqrt());
+            let mut pred = 0.0;
+            for y in 0..T {
+                for x in 0..T {
+                    let s = maps.pixels[(ty * T + y) * w + tx * T + x].sigma;
+                    pred += s[0] + s[2];
+                }
+            }
+            let predicted = (pred / (T * T) as f64 - 2.0 * px_window)
+                .max(0.0)
+                .sqrt()
+                .min(NYQUIST_CAP);
+            let detail =
+                0.5 * (sa + sb) >= DETAIL * mean_l.max(1e-12) && signal > noise && measured > RESOLVED;
+            tiles.push(TileCheck {
+                tile: (tx, ty),
+                predicted,
+                measured,
+                detail,
+            });
+        }
+    }
+    let det: Vec<&TileCheck> = tiles.iter().filter(|t| t.detail && t.measured > 0.0).collect();
+    let mut ratios: Vec<f64> = det.iter().map(|t| t.predicted / t.measured).collect();
+    ratios.sort_by(f64::total_cmp);
+    let median_ratio = if ratios.is_empty() {
+        f64::NAN
+    } else {
+        ratios[ratios.len() / 2]
+    };
+    let pv: Vec<f64> = det.iter().map(|t| t.predicted).collect();
+    let mv: Vec<f64> = det.iter().map(|t| t.measured).collect();
+    let under = det.iter().filter(|t| t.predicted < 0.5 * t.measured).count();
+    Agreement {
+        detail_tiles: det.len(),
+        median_ratio,
+        rank_correlation: spearman(&pv, &mv),
+        undersampled: if det.is_empty() {
+            0.0
+        } else {
+            under as f64 / det.len() as f64
+        },
+        tiles,
+    }
+}

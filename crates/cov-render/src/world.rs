@@ -1,0 +1,679 @@
+//! The scene as the renderer uses it: camera, lights, materials and geometry, built from a
+//! [`SceneFile`] with every cross-reference checked.
+
+use std::f64::consts::PI;
+use std::path::Path;
+
+use glam::DVec3;
+
+use crate::geometry::{Geometry, Prim, Shape};
+use crate::material::{Material, basis};
+use crate::scene::{
+    LightDesc, MAX_SCENE_BYTES, MAX_TRIANGLES, MaterialDesc, SceneError, SceneFile, ShapeDesc, V3,
+    position_of,
+};
+
+fn v(a: V3) -> DVec3 {
+    DVec3::from_array(a.0)
+}
+
+/// A thin-lens (or pinhole) camera with a shutter and a velocity.
+#[derive(Clone, Copy, Debug)]
+pub struct Camera {
+    /// Lens centre at time 0.
+    pub position: DVec3,
+    /// Image right (unit).
+    pub right: DVec3,
+    /// Image up (unit).
+    pub up: DVec3,
+    /// Viewing direction (unit).
+    pub forward: DVec3,
+    /// `tan(fov_x/2)`.
+    pub tan_x: f64,
+    /// `tan(fov_y/2)`.
+    pub tan_y: f64,
+    /// Horizontal field of view (rad).
+    pub fov_x: f64,
+    /// Width (px).
+    pub width: u32,
+    /// Height (px).
+    pub height: u32,
+    /// Lens radius (m); 0: pinhole.
+    pub lens_radius: f64,
+    /// Distance in focus (m).
+    pub focus_distance: f64,
+    /// Focal length (m).
+    pub focal_length: f64,
+    /// Shutter interval (s), if time is sampled.
+    pub shutter: Option<(f64, f64)>,
+    /// Velocity (m/s).
+    pub velocity: DVec3,
+}
+
+/// A ray leaving the camera.
+#[derive(Clone, Copy, Debug)]
+pub struct CameraRay {
+    /// Origin (on the lens).
+    pub origin: DVec3,
+    /// Direction (unit).
+    pub dir: DVec3,
+    /// Time (s).
+    pub time: f64,
+}
+
+impl Camera {
+    /// The ray through the image point `(px, py)` (pixels, from the top-left corner), the
+    /// lens point `lens` (uniforms in `[0,1)²`, mapped to the disk) and the time uniform
+    /// `ut`.
+    pub fn ray(&self, px: f64, py: f64, lens: (f64, f64), ut: f64) -> CameraRay {
+        let nx = (2.0 * px / self.width as f64 - 1.0) * self.tan_x;
+        let ny = (1.0 - 2.0 * py / self.height as f64) * self.tan_y;
+        let pin = (self.forward + self.right * nx + self.up * ny).normalize();
+        let time = self.shutter.map_or(0.0, |(a, b)| a + (b - a) * ut);
+        let centre = self.position + self.velocity * time;
+        if self.lens_radius <= 0.0 {
+            return CameraRay {
+                origin: centre,
+                dir: pin,
+                time,
+            };
+        }
+        let focus = centre + pin * (self.focus_distance / pin.dot(self.forward));
+        let (dx, dy) = concentric_disk(lens.0, lens.1);
+        let origin = centre + (self.right * dx + self.up * dy) * self.lens_radius;
+        CameraRay {
+            origin,
+            dir: (focus - origin).normalize(),
+            time,
+        }
+    }
+
+    /// Lens to sensor (m): the thin-lens image distance, or the focal length for a pinhole.
+    pub fn sensor_distance(&self) -> f64 {
+        if self.lens_radius > 0.0 {
+            self.focal_length * self.focus_distance / (self.focus_distance - self.focal_length)
+        } else {
+            self.focal_length
+        }
+    }
+}
+
+/// Shirley's concentric map of the unit square onto the unit disk.
+pub fn concentric_disk(u: f64, v: f64) -> (f64, f64) {
+    let (a, b) = (2.0 * u - 1.0, 2.0 * v - 1.0);
+    if a == 0.0 && b == 0.0 {
+        return (0.0, 0.0);
+    }
+    let (r, phi) = if a.abs() > b.abs() {
+        (a, PI / 4.0 * (b / a))
+    } else {
+        (b, PI / 2.0 - PI / 4.0 * (a / b))
+    };
+    (r * phi.cos(), r * phi.sin())
+}
+
+/// An area light.
+#[derive(Clone, Copy, Debug)]
+pub enum Light {
+    /// A one-sided parallelogram.
+    Rect {
+        /// Corner.
+        corner: DVec3,
+        /// First edge.
+        eu: DVec3,
+        /// Second edge.
+        ev: DVec3,
+        /// Unit normal (`eu × ev`).
+        n: DVec3,
+        /// Area (m²).
+        area: f64,
+        /// Radiance.
+        radiance: DVec3,
+    },
+    /// A sphere.
+    Sphere {
+        /// Centre.
+        center: DVec3,
+        /// Radius.
+        radius: f64,
+        /// Radiance.
+        radiance: DVec3,
+    },
+}
+
+/// A point sampled on a light, seen from a shading point.
+#[derive(Clone, Copy, Debug)]
+pub struct LightSample {
+    /// The point.
+    pub y: DVec3,
+    /// The light's normal there.
+    pub n: DVec3,
+    /// Unit direction from the shading point to `y`.
+    pub wi: DVec3,
+    /// Distance to `y`.
+    pub dist: f64,
+    /// Density of `wi` in solid angle (for this light).
+    pub pdf: f64,
+    /// Radiance leaving `y` towards the shading point.
+    pub radiance: DVec3,
+}
+
+impl Light {
+    /// Radiance.
+    pub fn radiance(&self) -> DVec3 {
+        match *self {
+            Light::Rect { radiance, .. } | Light::Sphere { radiance, .. } => radiance,
+        }
+    }
+
+    /// The std of the emitter seen as a Gaussian window (m): a box of side `a` has std
+    /// `a/√12`; a disk of radius `r`, `r/2`.
+    pub fn window_std(&self) -> f64 {
+        match *self {
+            Light::Rect { area, .. } => area.sqrt() / 12f64.sqrt(),
+            Light::Sphere { radius, .. } => radius / 2.0,
+        }
+    }
+
+    /// Samples a point on the light as seen from `x` (uniforms `u1, u2`).
+    pub fn sample(&self, x: DVec3, u1: f64, u2: f64) -> Option<LightSample> {
+        match *self {
+            Light::Rect {
+                corner,
+                eu,
+                ev,
+                n,
+                area,
+                radiance,
+            } => {
+                let y = corner + eu * u1 + ev * u2;
+                let d = y - x;
+                let dist = d.length();
+                if dist <= 0.0 {
+                    return None;
+                }
+                let wi = d / dist;
+                let cos_l = -wi.dot(n);
+                if cos_l <= 0.0 {
+                    return None;
+                }
+                Some(LightSample {
+                    y,
+                    n,
+                    wi,
+                    dist,
+                    pdf: dist * dist / (cos_l * area),
+                    radiance,
+                })
+            }
+            Light::Sphere {
+                center,
+                radius,
+                radiance,
+            } => {
+                let dc = center - x;
+                let dist_c = dc.length();
+                if dist_c <= radius * (1.0 + 1e-9) {
+                    return None;
+                }
+                let w = dc / dist_c;
+                let sin2 = (radius / dist_c).powi(2);
+                let cos_max = (1.0 - sin2).max(0.0).sqrt();
+                let cos_t = 1.0 - u1 * (1.0 - cos_max);
+                let sin_t = (1.0 - cos_t * cos_t).max(0.0).sqrt();
+                let phi = 2.0 * PI * u2;
+                let (t, b) = basis(w);
+                let wi = (t * (sin_t * phi.cos()) + b * (sin_t * phi.sin()) + w * cos_t).normalize();
+                // The nearer intersection of the cone direction with the sphere.
+                let bq = -wi.dot(dc);
+                let c = dist_c * dist_c - radius * radius;
+                let disc = (bq * bq - c).max(0.0);
+                let dist = -bq - disc.sqrt();
+                let y = x + wi * dist;
+                Some(LightSample {
+                    y,
+                    n: (y - center).normalize(),
+                    wi,
+                    dist,
+                    pdf: 1.0 / (2.0 * PI * (1.0 - cos_max)),
+                    radiance,
+                })
+            }
+        }
+    }
+
+    /// Density in solid angle with which [`Light::sample`] picks `wi` from `x`, given that
+    /// the ray hits the light at distance `dist` where its normal is `n_hit`.
+    pub fn pdf(&self, x: DVec3, wi: DVec3, dist: f64, n_hit: DVec3) -> f64 {
+        match *self {
+            Light::Rect { n, area, .. } => {
+                let cos_l = -wi.dot(n);
+                if cos_l <= 0.0 {
+                    return 0.0;
+                }
+                let _ = n_hit;
+                dist * dist / (cos_l * area)
+            }
+            Light::Sphere { center, radius, .. } => {
+                let dist_c = (center - x).length();
+                if dist_c <= radius {
+                    return 0.0;
+                }
+                let cos_max = (1.0 - (radius / dist_c).powi(2)).max(0.0).sqrt();
+                1.0 / (2.0 * PI * (1.0 - cos_max))
+            }
+        }
+    }
+}
+
+/// Everything the renderer needs.
+#[derive(Debug)]
+pub struct World {
+    /// The file it came from.
+    pub file: String,
+    /// The camera.
+    pub camera: Camera,
+    /// Materials, by index.
+    pub materials: Vec<Material>,
+    /// Material names, by index.
+    pub material_names: Vec<String>,
+    /// Lights, by index.
+    pub lights: Vec<Light>,
+    /// Primitives under a BVH.
+    pub geometry: Geometry,
+    /// Whether anything moves during an open shutter (the covariance is then traced with
+    /// a time axis, layout 5; else layout 4).
+    pub has_motion: bool,
+}
+
+impl World {
+    /// The same scene at another resolution (the vertical field of view follows the new
+    /// aspect ratio; sides are clamped to 1..=[`crate::scene::MAX_RESOLUTION`]).
+    pub fn with_resolution(mut self, width: u32, height: u32) -> World {
+        let (w, h) = (
+            width.clamp(1, crate::scene::MAX_RESOLUTION),
+            height.clamp(1, crate::scene::MAX_RESOLUTION),
+        );
+        self.camera.width = w;
+        self.camera.height = h;
+        self.camera.tan_y = self.camera.tan_x * h as f64 / w as f64;
+        self
+    }
+
+    /// Reads and builds a scene file.
+    ///
+    /// # Errors
+    /// An unreadable or oversized file, or any error of [`World::from_text`].
+    pub fn load(path: &Path) -> Result<World, SceneError> {
+        let file = path.display().to_string();
+        let err = |message: String| SceneError {
+            file: file.clone(),
+            at: None,
+            message,
+        };
+        let meta = std::fs::metadata(path).map_err(|e| err(e.to_string()))?;
+        if meta.len() > MAX_SCENE_BYTES {
+            return Err(err(format!(
+                "the file is {} bytes; scene files are read up to {MAX_SCENE_BYTES} bytes",
+                meta.len()
+            )));
+        }
+        let bytes = std::fs::read(path).map_err(|e| err(e.to_string()))?;
+        let text = String::from_utf8(bytes).map_err(|e| {
+            let good = &e.as_bytes()[..e.utf8_error().valid_up_to()];
+            let text = String::from_utf8_lossy(good);
+            let line = text.matches('\n').count() + 1;
+            let col = text.rsplit('\n').next().map_or(0, |l| l.chars().count()) + 1;
+            SceneError {
+                file: file.clone(),
+                at: Some((line, col)),
+                message: "the file is not UTF-8 text".into(),
+            }
+        })?;
+        let dir = path.parent().unwrap_or(Path::new("."));
+        Self::from_text(&text, &file, dir)
+    }
+
+    /// Builds a scene from text; `file` names it in errors and `dir` is where OBJ paths
+    /// are resolved.
+    ///
+    /// # Errors
+    /// Malformed or out-of-range input, an unknown material, an unreadable OBJ: one
+    /// positioned line.
+    pub fn from_text(text: &str, file: &str, dir: &Path) -> Result<World, SceneError> {
+        let desc = SceneFile::parse(text, file)?;
+        let at = |needle: &str, message: String| SceneError {
+            file: file.to_string(),
+            at: position_of(text, needle),
+            message,
+        };
+        // Camera.
+        let c = &desc.camera;
+        let position = v(c.position);
+        let look = v(c.look_at) - position;
+        if look.length() <= 0.0 {
+            return Err(at("look_at", "the camera looks at its own position".into()));
+        }
+        let forward = look.normalize();
+        let up0 = c.up.map_or(DVec3::Y, v);
+        let right = forward.cross(up0);
+        if right.length() <= 1e-12 {
+            return Err(at("position", "`up` is parallel to the viewing direction".into()));
+        }
+        let right = right.normalize();
+        let up = right.cross(forward);
+        let fov_x = c.fov.0.to_radians();
+        if fov_x >= PI {
+            return Err(at(
+                "fov",
+                format!("fov must be below 180 degrees, got {}", c.fov.0),
+            ));
+        }
+        let (width, height) = (c.width.0, c.height.0);
+        let tan_x = (fov_x / 2.0).tan();
+        let tan_y = tan_x * height as f64 / width as f64;
+        let (lens_radius, focus_distance, focal_length) = match &c.lens {
+            Some(l) => {
+                let f = l.focal_length.map_or(0.05, |f| f.0);
+                if l.focus_distance.0 <= f {
+                    return Err(at(
+                        "focus_distance",
+                        format!(
+                            "focus_distance {} must exceed the focal length {f} (a real image)",
+                            l.focus_distance.0
+                        ),
+                    ));
+                }
+                (l.aperture.0, l.focus_distance.0, f)
+            }
+            None => (0.0, 1.0, 0.05),
+        };
+        let shutter = match &c.shutter {
+            Some(s) if s.close.0 > s.open.0 => Some((s.open.0, s.close.0)),
+            Some(s) => {
+                return Err(at(
+                    "close",
+                    format!(
+                        "the shutter closes ({}) before it opens ({})",
+                        s.close.0, s.open.0
+                    ),
+                ));
+            }
+            None => None,
+        };
+        let cam_velocity = c.velocity.map_or(DVec3::ZERO, v);
+        let camera = Camera {
+            position,
+            right,
+            up,
+            forward,
+            tan_x,
+            tan_y,
+            fov_x,
+            width,
+            height,
+            lens_radius,
+            focus_distance,
+            focal_length,
+            shutter,
+            velocity: cam_velocity,
+        };
+        // Materials.
+        let mut materials = Vec::new();
+        let mut material_names = Vec::new();
+        for (name, m) in &desc.materials {
+            let mat = match *m {
+                MaterialDesc::Diffuse { albedo } => Material::Diffuse {
+                    albedo: DVec3::from_array(albedo.0),
+                },
+                MaterialDesc::Phong { albedo, exponent } => Material::Phong {
+                    albedo: DVec3::from_array(albedo.0),
+                    exponent: exponent.0,
+                },
+                MaterialDesc::Ggx { albedo, alpha } => Material::Ggx {
+                    albedo: DVec3::from_array(albedo.0),
+                    alpha: alpha.0,
+                },
+            };
+            let albedo = match mat {
+                Material::Diffuse { albedo }
+                | Material::Phong { albedo, .. }
+                | Material::Ggx { albedo, .. } => albedo,
+            };
+            if albedo.max_element() > 1.0 {
+                return Err(at(
+                    &format!("\"{name}\""),
+                    format!("material `{name}`: an albedo above 1 reflects more than it receives"),
+                ));
+            }
+            materials.push(mat);
+            material_names.push(name.clone());
+        }
+        let material_index = |name: &str| -> Result<u32, SceneError> {
+            material_names
+                .iter()
+                .position(|n| n == name)
+                .map(|i| i as u32)
+                .ok_or_else(|| {
+                    at(
+                        &format!("\"{name}\""),
+                        format!(
+                            "unknown material `{}`; the scene defines: {}",
+                            crate::echo(name),
+                            if material_names.is_empty() {
+                                "none".into()
+                            } else {
+                                material_names.join(", ")
+                            }
+                        ),
+                    )
+                })
+        };
+        // Lights (emitters are also geometry, so the camera sees them).
+        let mut prims = Vec::new();
+        let mut lights = Vec::new();
+        for l in &desc.lights {
+            let index = lights.len() as u32;
+            match *l {
+                LightDesc::Rect {
+                    corner,
+                    edge_u,
+                    edge_v,
+                    radiance,
+                } => {
+                    let (c0, eu, ev) = (v(corner), v(edge_u), v(edge_v));
+                    let cr = eu.cross(ev);
+                    if cr.length() <= 0.0 {
+                        return Err(at("Rect", "a Rect light's edges are parallel (zero area)".into()));
+                    }
+                    lights.push(Light::Rect {
+                        corner: c0,
+                        eu,
+                        ev,
+                        n: cr.normalize(),
+                        area: cr.length(),
+                        radiance: DVec3::from_array(radiance.0),
+                    });
+                    for tri in quad_triangles(c0, eu, ev) {
+                        prims.push(Prim {
+                            shape: Shape::Triangle { v: tri, n: None },
+                            velocity: DVec3::ZERO,
+                            material: u32::MAX,
+                            light: Some(index),
+                        });
+                    }
+                }
+                LightDesc::Sphere {
+                    center,
+                    radius,
+                    radiance,
+                } => {
+                    lights.push(Light::Sphere {
+                        center: v(center),
+                        radius: radius.0,
+                        radiance: DVec3::from_array(radiance.0),
+                    });
+                    prims.push(Prim {
+                        shape: Shape::Sphere {
+                            center: v(center),
+                            radius: radius.0,
+                        },
+                        velocity: DVec3::ZERO,
+                        material: u32::MAX,
+                        light: Some(index),
+                    });
+                }
+            }
+        }
+        if lights.is_empty() {
+            return Err(at("lights", "the scene has no light (`lights: []`)".into()));
+        }
+        // Shapes.
+        let mut triangles = 0usize;
+        let mut any_velocity = cam_velocity != DVec3::ZERO;
+        for s in &desc.shapes {
+            match s {
+                ShapeDesc::Sphere {
+                    center,
+                    radius,
+                    material,
+                    velocity,
+                } => {
+                    let vel = velocity.map_or(DVec3::ZERO, v);
+                    any_velocity |= vel != DVec3::ZERO;
+                    prims.push(Prim {
+                        shape: Shape::Sphere {
+                            center: v(*center),
+                            radius: radius.0,
+                        },
+                        velocity: vel,
+                        material: material_index(material)?,
+                        light: None,
+                    });
+                }
+                ShapeDesc::Quad {
+                    corner,
+                    edge_u,
+                    edge_v,
+                    material,
+                    velocity,
+                } => {
+                    let vel = velocity.map_or(DVec3::ZERO, v);
+                    any_velocity |= vel != DVec3::ZERO;
+                    let m = material_index(material)?;
+                    if v(*edge_u).cross(v(*edge_v)).length() <= 0.0 {
+                        return Err(at("Quad", "a Quad's edges are parallel (zero area)".into()));
+                    }
+                    for tri in quad_triangles(v(*corner), v(*edge_u), v(*edge_v)) {
+                        prims.push(Prim {
+                            shape: Shape::Triangle { v: tri, n: None },
+                            velocity: vel,
+                            material: m,
+                            light: None,
+                        });
+                    }
+                }
+                ShapeDesc::Mesh {
+                    obj,
+                    material,
+                    translate,
+                    scale,
+                    velocity,
+                } => {
+                    let vel = velocity.map_or(DVec3::ZERO, v);
+                    any_velocity |= vel != DVec3::ZERO;
+                    let m = material_index(material)?;
+                    let needle = format!("\"{obj}\"");
+                    let tris = load_obj(&dir.join(obj), MAX_TRIANGLES - triangles)
+                        .map_err(|e| at(&needle, format!("OBJ `{}`: {e}", crate::echo(obj))))?;
+                    triangles += tris.len();
+                    let (t, sc) = (translate.map_or(DVec3::ZERO, v), scale.map_or(1.0, |s| s.0));
+                    for (p, n) in tris {
+                        prims.push(Prim {
+                            shape: Shape::Triangle {
+                                v: p.map(|q| q * sc + t),
+                                n,
+                            },
+                            velocity: vel,
+                            material: m,
+                            light: None,
+                        });
+                    }
+                }
+            }
+        }
+        let (t0, t1) = shutter.unwrap_or((0.0, 0.0));
+        let has_motion = shutter.is_some() && any_velocity;
+        Ok(World {
+            file: file.to_string(),
+            camera,
+            materials,
+            material_names,
+            lights,
+            geometry: Geometry::new(prims, t0, t1),
+            has_motion,
+        })
+    }
+}
+
+fn quad_triangles(c: DVec3, eu: DVec3, ev: DVec3) -> [[DVec3; 3]; 2] {
+    [[c, c + eu, c + eu + ev], [c, c + eu + ev, c + ev]]
+}
+
+type ObjTriangle = ([DVec3; 3], Option<[DVec3; 3]>);
+
+/// Triangles (and vertex normals when the file has them) of an OBJ file, at most `limit`.
+fn load_obj(path: &Path, limit: usize) -> Result<Vec<ObjTriangle>, String> {
+    if !path.is_file() {
+        return Err(format!("no such file: {}", path.display()));
+    }
+    let opts = tobj::LoadOptions {
+        triangulate: true,
+        single_index: true,
+        ..Default::default()
+    };
+    let (models, _materials) = tobj::load_obj(path, &opts).map_err(|e| e.to_string())?;
+    let mut out = Vec::new();
+    for m in &models {
+        let mesh = &m.mesh;
+        let get = |data: &[f32], i: u32| -> Option<DVec3> {
+            let i = 3 * i as usize;
+            let a = data.get(i..i + 3)?;
+            let p = DVec3::new(a[0] as f64, a[1] as f64, a[2] as f64);
+            p.is_finite().then_some(p)
+        };
+        for f in mesh.indices.chunks_exact(3) {
+            if out.len() >= limit {
+                return Err(format!(
+                    "more than {MAX_TRIANGLES} triangles in the scene; meshes are read up to that"
+                ));
+            }
+            let p = [
+                get(&mesh.positions, f[0]).ok_or("a vertex index is out of range or not finite")?,
+                get(&mesh.positions, f[1]).ok_or("a vertex index is out of range or not finite")?,
+                get(&mesh.positions, f[2]).ok_or("a vertex index is out of range or not finite")?,
+            ];
+            let n = if mesh.normals.is_empty() {
+                None
+            } else {
+                match (
+                    get(&mesh.normals, f[0]),
+                    get(&mesh.normals, f[1]),
+                    get(&mesh.normals, f[2]),
+                ) {
+                    (Some(a), Some(b), Some(c)) => Some([
+                        a.normalize_or_zero(),
+                        b.normalize_or_zero(),
+                        c.normalize_or_zero(),
+                    ]),
+                    _ => None,
+                }
+            };
+            out.push((p, n));
+        }
+    }
+    if out.is_empty() {
+        return Err("the file has no triangles".into());
+    }
+    Ok(out)
+}

@@ -1,0 +1,108 @@
+//! The renderer: determinism, energy against a closed form, the covariance maps' invariants.
+
+use std::path::{Path, PathBuf};
+
+use cov_render::World;
+use cov_render::render::{covariance_maps, render, render_adaptive};
+
+fn scenes() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/scenes")
+}
+
+fn load(name: &str, w: u32, h: u32) -> World {
+    World::load(&scenes().join(name))
+        .unwrap_or_else(|e| panic!("{e}"))
+        .with_resolution(w, h)
+}
+
+fn pool(threads: usize) -> rayon::ThreadPool {
+    rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .expect("pool")
+}
+
+#[test]
+fn every_bundled_scene_renders_the_same_on_one_and_two_threads() {
+    for name in ["cornell.ron", "pool.ron", "glossy.ron"] {
+        let world = load(name, 24, 18);
+        let a = pool(1).install(|| render(&world, 4, 7));
+        let b = pool(2).install(|| render(&world, 4, 7));
+        assert_eq!(a, b, "{name}: image differs with the thread count");
+        assert!(
+            a.pixels.iter().all(|p| p.is_finite() && p.min_element() >= 0.0),
+            "{name}"
+        );
+        assert!(
+            a.pixels.iter().any(|p| p.max_element() > 0.0),
+            "{name}: black image"
+        );
+        let ma = pool(1).install(|| covariance_maps(&world, 2, 7)).unwrap();
+        let mb = pool(2).install(|| covariance_maps(&world, 2, 7)).unwrap();
+        assert_eq!(ma, mb, "{name}: covariance maps differ with the thread count");
+        // A different seed gives a different image (the seed is used).
+        assert_ne!(a, pool(2).install(|| render(&world, 4, 8)), "{name}");
+    }
+}
+
+/// A diffuse plane of albedo ρ under a sphere light of radiance L and radius R whose
+/// centre is D above the point seen: the irradiance is `π L (R/D)²`, so the radiance
+/// leaving the plane is `ρ L (R/D)²`. The estimator (MIS direct light plus a bounce that
+/// only finds the light) must match it within its Monte Carlo error.
+#[test]
+fn a_diffuse_plane_under_a_sphere_light_matches_the_closed_form() {
+    let text = r#"Scene(
+        camera: (position: (0.0, 1.0, 0.0), look_at: (0.0, 0.0, 0.0), up: (0.0, 0.0, -1.0), fov: 0.5, width: 1, height: 1),
+        materials: { "grey": Diffuse(albedo: (0.5, 0.5, 0.5)) },
+        lights: [Sphere(center: (0.0, 2.0, 0.0), radius: 0.5, radiance: (1.0, 1.0, 1.0))],
+        shapes: [Quad(corner: (-50.0, 0.0, -50.0), edge_u: (100.0, 0.0, 0.0), edge_v: (0.0, 0.0, 100.0), material: "grey")],
+    )"#;
+    let world = World::from_text(text, "<test>", Path::new(".")).unwrap();
+    let n = 20_000u32;
+    let (img, var) = render_adaptive(&world, &[n], 3, None);
+    let exact = 0.5 * (0.5f64 / 2.0).powi(2);
+    let got = img.pixels[0].y;
+    let stderr = (var[0] / n as f64).sqrt();
+    assert!(stderr > 0.0 && stderr < 0.02 * exact, "stderr {stderr}");
+    assert!(
+        (got - exact).abs() <= 4.0 * stderr,
+        "got {got}, closed form {exact}, 4σ = {}",
+        4.0 * stderr
+    );
+}
+
+#[test]
+fn covariance_maps_are_finite_psd_and_see_the_scene() {
+    for name in ["cornell.ron", "pool.ron", "glossy.ron"] {
+        let world = load(name, 32, 24);
+        let maps = covariance_maps(&world, 4, 1).unwrap();
+        assert_eq!(maps.pixels.len(), 32 * 24);
+        for p in &maps.pixels {
+            let [a, b, c] = p.sigma;
+            assert!(
+                a.is_finite() && b.is_finite() && c.is_finite() && p.spp.is_finite(),
+                "{name}: {p:?}"
+            );
+            assert!(
+                a >= 0.0 && c >= 0.0 && a * c - b * b >= -1e-9 * (a * c).max(1e-300),
+                "{name}: not PSD {p:?}"
+            );
+            assert!(p.spp >= 0.0);
+        }
+        // The prediction varies over the image: some pixels need more samples than others.
+        let (lo, hi) = maps
+            .pixels
+            .iter()
+            .fold((f64::INFINITY, 0.0f64), |(l, h), p| (l.min(p.spp), h.max(p.spp)));
+        assert!(hi > 2.0 * lo, "{name}: flat prediction {lo}..{hi}");
+    }
+    // Motion and defocus enter the layout only where the scene has them.
+    assert_eq!(
+        covariance_maps(&load("cornell.ron", 8, 6), 1, 1).unwrap().layout,
+        5
+    );
+    assert_eq!(
+        covariance_maps(&load("glossy.ron", 8, 6), 1, 1).unwrap().layout,
+        4
+    );
+}
