@@ -2,7 +2,9 @@
 
 use std::path::{Path, PathBuf};
 
-use cov_render::render::{covariance_maps_with, render_adaptive, tile_count, timed, write_image, write_maps};
+use cov_render::render::{
+    covariance_maps_with, render_adaptive, render_clamped, tile_count, timed, write_image, write_maps,
+};
 use cov_render::{MAX_COV_PATHS, MAX_SPP, World};
 use indicatif::{ProgressBar, ProgressStyle};
 
@@ -195,11 +197,41 @@ pub fn check(a: &CheckArgs) -> Result<String, String> {
     let (w, h) = (world.camera.width, world.camera.height);
     let tiles = tile_count(&world);
     // Two independent references (other seeds): their cross-spectrum has no noise term.
+    // Samples are clamped at 4× the image's mean luminance (from a 4-spp preview), so
+    // that rare caustic fireflies, which no pair of renders cancels, do not read as detail.
+    let preview = render_adaptive(
+        &world,
+        &vec![4; (w * h) as usize],
+        a.seed.wrapping_add(3000),
+        None,
+    )
+    .0;
+    let mean_l = preview
+        .pixels
+        .iter()
+        .map(|p| cov_render::trace::luminance(*p))
+        .sum::<f64>()
+        / (w * h) as f64;
+    let clamp = if mean_l > 0.0 { 4.0 * mean_l } else { f64::INFINITY };
     let b = bar(2 * tiles, "reference");
     let counts = vec![a.ref_spp; (w * h) as usize];
     let ((ref_a, ref_b), t_ref) = timed(|| {
-        let ra = render_adaptive(&world, &counts, a.seed.wrapping_add(1000), Some(&|| b.inc(1))).0;
-        let rb = render_adaptive(&world, &counts, a.seed.wrapping_add(2000), Some(&|| b.inc(1))).0;
+        let ra = render_clamped(
+            &world,
+            &counts,
+            a.seed.wrapping_add(1000),
+            clamp,
+            Some(&|| b.inc(1)),
+        )
+        .0;
+        let rb = render_clamped(
+            &world,
+            &counts,
+            a.seed.wrapping_add(2000),
+            clamp,
+            Some(&|| b.inc(1)),
+        )
+        .0;
         (ra, rb)
     });
     b.finish_and_clear();

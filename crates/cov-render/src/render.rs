@@ -92,6 +92,19 @@ pub fn render_adaptive(
     seed: u64,
     progress: Progress<'_>,
 ) -> (Image, Vec<f64>) {
+    render_clamped(world, counts, seed, f64::INFINITY, progress)
+}
+
+/// [`render_adaptive`] with every sample's luminance clamped to `max_luminance` (colour
+/// scaled down). Biased: for measuring the spectrum of a reference without its rare
+/// caustic fireflies (`covtrace render-check`), never for an image.
+pub fn render_clamped(
+    world: &World,
+    counts: &[u32],
+    seed: u64,
+    max_luminance: f64,
+    progress: Progress<'_>,
+) -> (Image, Vec<f64>) {
     let (w, h) = (world.camera.width, world.camera.height);
     let tl = tiles(w, h);
     let results: Vec<Vec<(DVec3, f64)>> = tl
@@ -123,6 +136,12 @@ pub fn render_adaptive(
                         );
                         let l = radiance(world, &ray, &mut rng);
                         let l = if l.is_finite() { l } else { DVec3::ZERO };
+                        let y_l = crate::trace::luminance(l);
+                        let l = if y_l > max_luminance {
+                            l * (max_luminance / y_l)
+                        } else {
+                            l
+                        };
                         sum += l;
                         let y_l = crate::trace::luminance(l);
                         sum_l += y_l;

@@ -9,14 +9,17 @@
 //! of that power spectrum, less the Hann window's own: for a Gaussian the amplitude
 //! spectrum's Σ (PHYSICS.md §1) is exactly twice the power spectrum's, and the power
 //! moment is linear in the cross-spectrum, so noise cancels in expectation (the amplitude
-//! `√cross` of single noisy bins would not: it is biased upwards). The predicted Σ is the mean of the covariance pass's per-pixel Σ over the
+//! `√cross` of single noisy bins would not: it is biased upwards). The moment is taken over
+//! [`RINGS`] rings of frequency, each kept only when its cross power is significant: above
+//! [`SIGNIFICANCE`] standard deviations of its noise (for white noise of power `n` per bin, the cross
+//! power of a ring of `m` bins has std `n·√(m/2)`). The predicted Σ is the mean of the covariance pass's per-pixel Σ over the
 //! tile, minus the pixel filter's own window (the sensor adds `1/(4π² f²)` per axis for a
 //! filter of std `f` px), so that both describe the image's content.
 //!
 //! Bandwidths are `√tr Σ` (cycles/px); predictions are capped at [`NYQUIST_CAP`], the
 //! most an image can show. A tile **has detail** when its luminance std is at least
-//! [`DETAIL`] of the image's mean luminance, its signal power stands above its noise power
-//! (estimated from the difference of the two references), and its measured bandwidth is
+//! [`DETAIL`] of the image's mean luminance, its signal power is at least twice its noise
+//! power (estimated from the difference of the two references), and its measured bandwidth is
 //! above [`RESOLVED`], what a `T`-pixel tile resolves beyond its first frequency bins (a
 //! smooth gradient is not detail). A tile is **under-sampled** when the predicted bandwidth
 //! is below half the measured one: the prediction would give it too few samples.
@@ -33,6 +36,11 @@ use crate::trace::luminance;
 pub const T: usize = 16;
 /// A tile has detail when its luminance std is at least this fraction of the image mean.
 pub const DETAIL: f64 = 0.02;
+/// A ring's cross power counts when above this many standard deviations of its noise (5:
+/// caustic fireflies are heavy-tailed, far from the Gaussian that 3σ assumes).
+pub const SIGNIFICANCE: f64 = 5.0;
+/// Rings of frequency over which the cross power is tested for significance.
+pub const RINGS: usize = 8;
 /// Bandwidth a tile resolves beyond its first bins, `2/T` cycles/px.
 pub const RESOLVED: f64 = 2.0 / T as f64;
 /// The largest bandwidth an image of box-filtered pixels can show, `√(2·0.5²)` cycles/px.
@@ -121,6 +129,45 @@ fn second_moment(amp: &[f64]) -> Option<f64> {
         }
     }
     (s > 0.0).then(|| m / s)
+}
+
+/// The second moment of the cross power of `fa`, `fb` over the rings of frequency whose
+/// cross power is significant (DC excluded).
+fn ring_moment(fa: &[Complex<f64>], fb: &[Complex<f64>]) -> Option<f64> {
+    let fmax = std::f64::consts::FRAC_1_SQRT_2;
+    let mut c = [0.0; RINGS];
+    let mut f2 = [0.0; RINGS];
+    let mut noise = [0.0; RINGS];
+    let mut m = [0usize; RINGS];
+    for ky in 0..T {
+        for kx in 0..T {
+            if kx == 0 && ky == 0 {
+                continue;
+            }
+            let (fx, fy) = (freq(kx), freq(ky));
+            let r2 = fx * fx + fy * fy;
+            let ring = ((r2.sqrt() / fmax * RINGS as f64) as usize).min(RINGS - 1);
+            let k = ky * T + kx;
+            let cross = (fa[k] * fb[k].conj()).re;
+            c[ring] += cross;
+            f2[ring] += cross * r2;
+            noise[ring] += (fa[k] - fb[k]).norm_sqr() / 2.0;
+            m[ring] += 1;
+        }
+    }
+    let (mut s, mut mom) = (0.0, 0.0);
+    for r in 0..RINGS {
+        if m[r] == 0 {
+            continue;
+        }
+        let per_bin = noise[r] / m[r] as f64;
+        let sigma = per_bin * (m[r] as f64 / 2.0).sqrt();
+        if c[r] > SIGNIFICANCE * sigma && c[r] > 0.0 {
+            s += c[r];
+            mom += f2[r];
+        }
+    }
+    (s > 0.0).then(|| (mom / s).max(0.0))
 }
 
 /// Ranks (average ranks for ties) of `v`.
@@ -213,7 +260,7 @@ pub fn compare(a: &Image, b: &Image, maps: &CovMaps, pixel_filter: f64) -> Agree
             // Noise power from the difference of the two renders: E|F_a − F_b|² = 2 N.
             let noise: f64 = fa.iter().zip(&fb).map(|(p, q)| (p - q).norm_sqr()).sum::<f64>() / 2.0;
             let signal: f64 = cross.iter().sum::<f64>();
-            let measured = second_moment(&cross).map_or(0.0, |m| (2.0 * (m - own)).max(0.0).sqrt());
+            let measured = ring_moment(&fa, &fb).map_or(0.0, |m| (2.0 * (m - own)).max(0.0).sqrt());
             let mut pred = 0.0;
             for y in 0..T {
                 for x in 0..T {
