@@ -46,7 +46,7 @@ enum Command {
         /// Add the 512-point grid (slow).
         #[arg(long)]
         full: bool,
-        /// Output chart (SVG).
+        /// Output chart (SVG; a PNG is written beside it).
         #[arg(short, long, default_value = "validate_report.svg")]
         output: String,
     },
@@ -174,13 +174,18 @@ fn run(cli: Cli) -> Result<(), String> {
             }
         }
         Command::Plot { path, output } => {
+            cov_cli::render::check_output(&output, "png")?;
             let p = Path::load(&path, &registry).map_err(|e| e.to_string())?;
             let e = p.eval().map_err(|e| e.to_string())?;
-            let legend = plot::plot(&e, &output).map_err(|e| format!("{}: {e}", output.display()))?;
+            let legend = plot::plot(&e, &path.display().to_string(), &output)?;
             say!("{}", legend.trim_end());
             say!("written to {}", output.display());
         }
         Command::Validate { full, output } => {
+            // The chart is written as SVG and as PNG beside it; both paths are checked first.
+            let out = std::path::PathBuf::from(&output);
+            cov_cli::render::check_output(&out, "svg")?;
+            let png = out.with_extension("png");
             let sizes = report::sizes(full);
             let total = report::cases().map_err(|e| e.to_string())?.len() * sizes.len();
             let bar = ProgressBar::new(total as u64);
@@ -201,7 +206,9 @@ fn run(cli: Cli) -> Result<(), String> {
             .map_err(|e| e.to_string())?;
             bar.finish_and_clear();
             report::chart(&output, &rows).map_err(|e| format!("{output}: {e}"))?;
-            say!("chart written to {output}");
+            let png_name = png.display().to_string();
+            report::chart(&png_name, &rows).map_err(|e| format!("{png_name}: {e}"))?;
+            say!("chart written to {output} and {png_name}");
         }
         Command::Stiff { length } => {
             let cases = cov_stiff::cases(length);

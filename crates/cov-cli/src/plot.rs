@@ -1,127 +1,293 @@
 //! `covtrace plot`: one panel per step with the 1-σ ellipse of the spectrum in each
-//! (position, direction) plane: red (Ω_x, Ω_u), blue (Ω_y, Ω_v) in 3D, green (Ω_x, Ω_t)
-//! with time. All panels share one scale per plane, so sizes compare across steps.
+//! (position, direction) plane, drawn with plotters and an embedded font (DejaVu Sans, the
+//! `dejavu` crate), so the picture carries its own title, step names, axes with units, tick
+//! labels and legend. All panels share one scale per plane, so sizes compare across steps.
+//!
+//! Planes are told apart by colour and by line style (they stay distinct in greyscale):
+//! `(Ωx, Ωu)` solid dark red, `(Ωy, Ωv)` dashed blue, `(Ωx, Ωt)` dotted green on the
+//! panel's right axis (cycles/s).
 
-use image::{Rgb, RgbImage};
+use plotters::coord::Shift;
+use plotters::prelude::*;
 
 use covtrace::path::Evaluation;
 
-const PANEL: u32 = 220;
+/// Panel size (px).
+const PANEL: (u32, u32) = (300, 260);
+/// Panels per row.
 const PER_ROW: u32 = 4;
+/// Heights of the title band and the legend band (px).
+const TITLE_H: u32 = 44;
+const LEGEND_H: u32 = 44;
 
-/// The (row, col) index pairs drawn and their colours for layout `n`.
-fn planes(n: usize) -> Vec<((usize, usize), Rgb<u8>, &'static str)> {
-    match n {
-        2 => vec![((0, 1), Rgb([200, 30, 30]), "red: (Ωx, Ωu)")],
-        3 => vec![
-            ((0, 1), Rgb([200, 30, 30]), "red: (Ωx, Ωu)"),
-            ((0, 2), Rgb([20, 150, 40]), "green: (Ωx, Ωt)"),
-        ],
-        4 => vec![
-            ((0, 2), Rgb([200, 30, 30]), "red: (Ωx, Ωu)"),
-            ((1, 3), Rgb([30, 60, 200]), "blue: (Ωy, Ωv)"),
-        ],
-        _ => vec![
-            ((0, 2), Rgb([200, 30, 30]), "red: (Ωx, Ωu)"),
-            ((1, 3), Rgb([30, 60, 200]), "blue: (Ωy, Ωv)"),
-            ((0, 4), Rgb([20, 150, 40]), "green: (Ωx, Ωt)"),
-        ],
-    }
-}
+/// Largest number of panels drawn: longer paths are subsampled evenly (the first and last
+/// steps always shown), so the picture stays readable and its size bounded.
+pub const MAX_PANELS: usize = 24;
 
-/// Draws the panels of `e` (source first, then every step) and returns the legend text.
+/// Registers the embedded font as `sans-serif` (once; later calls do nothing).
 ///
 /// # Errors
-/// The image cannot be written.
-pub fn plot(e: &Evaluation, out: &std::path::Path) -> Result<String, image::ImageError> {
-    let mut mats: Vec<(&str, Vec<Vec<f64>>)> = vec![("source", e.start.rows())];
-    for s in &e.steps {
-        mats.push((&s.operator, s.matrix.rows()));
-    }
-    let count = mats.len() as u32;
-    let cols = count.min(PER_ROW);
-    let rows = count.div_ceil(PER_ROW);
-    let mut img = RgbImage::from_pixel(cols * PANEL, rows * PANEL, Rgb([255, 255, 255]));
-    let planes = planes(e.layout);
-    // One scale per plane: the largest bandwidth on either of its axes over all steps;
-    // the (position, direction) planes share theirs, having the same units.
-    let mut scales: Vec<f64> = planes
-        .iter()
-        .map(|((a, b), _, _)| {
-            mats.iter()
-                .map(|(_, m)| m[*a][*a].max(m[*b][*b]).max(0.0).sqrt())
-                .fold(0.0f64, f64::max)
-        })
-        .collect();
-    let time_axis = if e.layout == 3 { 2 } else { 4 };
-    let shared = planes
-        .iter()
-        .zip(&scales)
-        .filter(|(((_, b), _, _), _)| *b != time_axis || e.layout < 3)
-        .fold(0.0f64, |m, (_, s)| m.max(*s));
-    for (((_, b), _, _), s) in planes.iter().zip(scales.iter_mut()) {
-        if *b != time_axis || e.layout < 3 {
-            *s = shared;
-        }
-    }
-    for (k, (_, m)) in mats.iter().enumerate() {
-        let (ox, oy) = ((k as u32 % PER_ROW) * PANEL, (k as u32 / PER_ROW) * PANEL);
-        // Frame and axes.
-        for t in 0..PANEL {
-            for (x, y) in [(t, 0), (t, PANEL - 1), (0, t), (PANEL - 1, t)] {
-                img.put_pixel(ox + x, oy + y, Rgb([180, 180, 180]));
-            }
-            img.put_pixel(ox + t, oy + PANEL / 2, Rgb([225, 225, 225]));
-            img.put_pixel(ox + PANEL / 2, oy + t, Rgb([225, 225, 225]));
-        }
-        for (((a, b), color, _), scale) in planes.iter().zip(&scales) {
-            if *scale <= 0.0 || !scale.is_finite() {
-                continue;
-            }
-            draw_ellipse(
-                &mut img,
-                (ox, oy),
-                [m[*a][*a], m[*a][*b], m[*b][*b]],
-                *scale,
-                *color,
-            );
-        }
-    }
-    img.save(out)?;
-    let mut legend = format!(
-        "{} panels, left to right, top to bottom: {}\n",
-        count,
-        mats.iter().map(|(n, _)| *n).collect::<Vec<_>>().join(", ")
-    );
-    for ((_, _, name), s) in planes.iter().zip(&scales) {
-        legend.push_str(&format!(
-            "{name}: half a panel = {:.4e} cycles per unit\n",
-            s * 1.1
-        ));
-    }
-    Ok(legend)
+/// The embedded font does not parse (never for the bundled bytes).
+pub fn register_font() -> Result<(), String> {
+    static DONE: std::sync::OnceLock<Result<(), String>> = std::sync::OnceLock::new();
+    DONE.get_or_init(|| {
+        plotters::style::register_font("sans-serif", FontStyle::Normal, dejavu::sans::regular())
+            .map_err(|_| "the embedded DejaVu Sans font does not parse".to_string())
+    })
+    .clone()
 }
 
-fn draw_ellipse(img: &mut RgbImage, origin: (u32, u32), s: [f64; 3], scale: f64, color: Rgb<u8>) {
-    // 1-σ contour: points Σ^{1/2} (cos φ, sin φ), via the eigen-decomposition of the 2×2 block.
+/// One plane of the spectrum: its row/column pair, colour, style and name.
+struct Plane {
+    axes: (usize, usize),
+    color: RGBColor,
+    style: LineKind,
+    name: &'static str,
+    time: bool,
+}
+
+#[derive(Clone, Copy)]
+enum LineKind {
+    Solid,
+    Dashed,
+    Dotted,
+}
+
+const RED: RGBColor = RGBColor(178, 24, 43);
+const BLUE: RGBColor = RGBColor(33, 102, 172);
+const GREEN: RGBColor = RGBColor(27, 120, 55);
+
+fn planes(n: usize) -> Vec<Plane> {
+    let xu = |a, b| Plane {
+        axes: (a, b),
+        color: RED,
+        style: LineKind::Solid,
+        name: "(Ωx, Ωu)",
+        time: false,
+    };
+    let yv = Plane {
+        axes: (1, 3),
+        color: BLUE,
+        style: LineKind::Dashed,
+        name: "(Ωy, Ωv)",
+        time: false,
+    };
+    let xt = |t| Plane {
+        axes: (0, t),
+        color: GREEN,
+        style: LineKind::Dotted,
+        name: "(Ωx, Ωt), right axis",
+        time: true,
+    };
+    match n {
+        2 => vec![xu(0, 1)],
+        3 => vec![xu(0, 1), xt(2)],
+        4 => vec![xu(0, 2), yv],
+        _ => vec![xu(0, 2), yv, xt(4)],
+    }
+}
+
+/// Points of the 1-σ contour of the 2×2 block `[a, b, c]` (`Σ^{1/2}` of the unit circle).
+fn ellipse(s: [f64; 3]) -> Vec<(f64, f64)> {
     let (a, b, c) = (s[0], s[1], s[2]);
     let tr = 0.5 * (a + c);
-    let disc = (0.25 * (a - c) * (a - c) + b * b).sqrt();
+    let disc = (0.5 * (a - c)).hypot(b);
     let (l1, l2) = ((tr + disc).max(0.0), (tr - disc).max(0.0));
     let theta = 0.5 * (2.0 * b).atan2(a - c);
     let (st, ct) = theta.sin_cos();
-    let half = f64::from(PANEL) / 2.0;
-    let px = |v: f64| v / (scale * 1.1) * (half - 4.0);
-    for k in 0..2000 {
-        let phi = k as f64 / 2000.0 * std::f64::consts::TAU;
-        let (e1, e2) = (l1.sqrt() * phi.cos(), l2.sqrt() * phi.sin());
-        let (x, y) = (ct * e1 - st * e2, st * e1 + ct * e2);
-        let (ix, iy) = (half + px(x), half - px(y));
-        for (dx, dy) in [(0.0, 0.0), (1.0, 0.0), (0.0, 1.0), (1.0, 1.0)] {
-            let (xx, yy) = (ix + dx, iy + dy);
-            if xx >= 0.0 && yy >= 0.0 && xx < f64::from(PANEL) && yy < f64::from(PANEL) {
-                img.put_pixel(origin.0 + xx as u32, origin.1 + yy as u32, color);
+    (0..=180)
+        .map(|k| {
+            let phi = k as f64 / 180.0 * std::f64::consts::TAU;
+            let (e1, e2) = (l1.sqrt() * phi.cos(), l2.sqrt() * phi.sin());
+            (ct * e1 - st * e2, st * e1 + ct * e2)
+        })
+        .collect()
+}
+
+/// Tick labels like `1.5e3`: short, with an exponent.
+fn tick(v: &f64) -> String {
+    if *v == 0.0 {
+        "0".into()
+    } else {
+        let s = format!("{v:.1e}");
+        s.replace(".0e", "e")
+    }
+}
+
+/// Which steps get a panel: all, or an even subsample of at most [`MAX_PANELS`].
+fn shown(count: usize) -> Vec<usize> {
+    if count <= MAX_PANELS {
+        return (0..count).collect();
+    }
+    let mut v: Vec<usize> = (0..MAX_PANELS)
+        .map(|i| (i as f64 * (count - 1) as f64 / (MAX_PANELS - 1) as f64).round() as usize)
+        .collect();
+    v.dedup();
+    v
+}
+
+/// Draws the panels of `e` (source first, then every step, subsampled beyond
+/// [`MAX_PANELS`]) into a PNG at `out`, titled with `name`; returns a text summary.
+///
+/// # Errors
+/// The image cannot be drawn or written.
+pub fn plot(e: &Evaluation, name: &str, out: &std::path::Path) -> Result<String, String> {
+    register_font()?;
+    let mut mats: Vec<(String, Vec<Vec<f64>>)> = vec![("source".into(), e.start.rows())];
+    for (i, s) in e.steps.iter().enumerate() {
+        mats.push((format!("{i}: {}", s.operator), s.matrix.rows()));
+    }
+    let idx = shown(mats.len());
+    let count = idx.len() as u32;
+    let cols = count.min(PER_ROW);
+    let rows = count.div_ceil(PER_ROW);
+    let (w, h) = (cols * PANEL.0, TITLE_H + rows * PANEL.1 + LEGEND_H);
+    let planes = planes(e.layout);
+    // One scale per kind of axis over all steps: position, direction, time.
+    let peak = |axis: usize| -> f64 {
+        mats.iter()
+            .map(|(_, m)| m[axis][axis].max(0.0).sqrt())
+            .fold(0.0f64, f64::max)
+    };
+    let pos_axes: Vec<usize> = planes.iter().map(|p| p.axes.0).collect();
+    let dir_axes: Vec<usize> = planes.iter().filter(|p| !p.time).map(|p| p.axes.1).collect();
+    let scale = |axes: &[usize]| -> f64 {
+        let s = axes.iter().map(|&a| peak(a)).fold(0.0f64, f64::max) * 1.15;
+        if s.is_finite() && s > 0.0 { s } else { 1.0 }
+    };
+    let (sx, sy) = (scale(&pos_axes), scale(&dir_axes));
+    let st = planes.iter().find(|p| p.time).map(|p| scale(&[p.axes.1]));
+    let mut buf = vec![0u8; (w * h * 3) as usize];
+    {
+        let root = BitMapBackend::with_buffer(&mut buf, (w, h)).into_drawing_area();
+        root.fill(&WHITE).map_err(|e| e.to_string())?;
+        let (top, rest) = root.split_vertically(TITLE_H);
+        let (body, legend) = rest.split_vertically(rows * PANEL.1);
+        top.draw(&Text::new(
+            format!(
+                "Spectrum ellipses (1σ) after each step: {name} (layout {}: {})",
+                e.layout,
+                e.axes.join(",")
+            ),
+            (12, 12),
+            ("sans-serif", 20).into_font().color(&BLACK),
+        ))
+        .map_err(|e| e.to_string())?;
+        let panels = body.split_evenly((rows as usize, PER_ROW.min(count) as usize));
+        for (area, &k) in panels.iter().zip(&idx) {
+            let (title, m) = &mats[k];
+            draw_panel(area, title, m, &planes, (sx, sy, st)).map_err(|e| e.to_string())?;
+        }
+        draw_legend(&legend, &planes, count as usize, mats.len()).map_err(|e| e.to_string())?;
+        root.present().map_err(|e| e.to_string())?;
+    }
+    let img = image::RgbImage::from_raw(w, h, buf).ok_or("image buffer size")?;
+    img.save(out).map_err(|e| format!("{}: {e}", out.display()))?;
+    Ok(format!(
+        "{} panels of {} steps ({}), {}×{} px",
+        count,
+        mats.len(),
+        planes.iter().map(|p| p.name).collect::<Vec<_>>().join(", "),
+        w,
+        h
+    ))
+}
+
+type DrawResult = Result<(), Box<dyn std::error::Error>>;
+
+fn draw_panel(
+    area: &DrawingArea<BitMapBackend<'_>, Shift>,
+    title: &str,
+    m: &[Vec<f64>],
+    planes: &[Plane],
+    (sx, sy, st): (f64, f64, Option<f64>),
+) -> DrawResult {
+    let mut chart = ChartBuilder::on(area)
+        .caption(title, ("sans-serif", 14))
+        .margin(6)
+        .x_label_area_size(34)
+        .y_label_area_size(50)
+        .right_y_label_area_size(if st.is_some() { 50 } else { 0 })
+        .build_cartesian_2d(-sx..sx, -sy..sy)?
+        .set_secondary_coord(-sx..sx, -st.unwrap_or(1.0)..st.unwrap_or(1.0));
+    chart
+        .configure_mesh()
+        .x_labels(5)
+        .y_labels(5)
+        .x_label_formatter(&tick)
+        .y_label_formatter(&tick)
+        .x_desc("Ω position [cycles/m]")
+        .y_desc("Ω direction [cycles/tan]")
+        .label_style(("sans-serif", 11))
+        .axis_desc_style(("sans-serif", 11))
+        .light_line_style(WHITE)
+        .bold_line_style(RGBColor(235, 235, 235))
+        .draw()?;
+    if st.is_some() {
+        chart
+            .configure_secondary_axes()
+            .y_labels(5)
+            .y_label_formatter(&tick)
+            .y_desc("Ω time [cycles/s]")
+            .label_style(("sans-serif", 11))
+            .axis_desc_style(("sans-serif", 11))
+            .draw()?;
+    }
+    for p in planes {
+        let (a, b) = p.axes;
+        let pts = ellipse([m[a][a], m[a][b], m[b][b]]);
+        let style = ShapeStyle::from(&p.color).stroke_width(2);
+        if p.time {
+            chart.draw_secondary_series(DashedLineSeries::new(pts, 2, 4, style))?;
+        } else {
+            match p.style {
+                LineKind::Solid => {
+                    chart.draw_series(LineSeries::new(pts, style))?;
+                }
+                LineKind::Dashed | LineKind::Dotted => {
+                    chart.draw_series(DashedLineSeries::new(pts, 7, 5, style))?;
+                }
             }
         }
     }
+    Ok(())
+}
+
+fn draw_legend(
+    area: &DrawingArea<BitMapBackend<'_>, Shift>,
+    planes: &[Plane],
+    shown: usize,
+    total: usize,
+) -> DrawResult {
+    let font = ("sans-serif", 14).into_font().color(&BLACK);
+    let mut x = 12;
+    for p in planes {
+        let style = ShapeStyle::from(&p.color).stroke_width(3);
+        let (y, x1) = (18, x + 36);
+        match p.style {
+            LineKind::Solid => area.draw(&PathElement::new(vec![(x, y), (x1, y)], style))?,
+            LineKind::Dashed => {
+                area.draw(&PathElement::new(vec![(x, y), (x + 12, y)], style))?;
+                area.draw(&PathElement::new(vec![(x + 20, y), (x1, y)], style))?;
+            }
+            LineKind::Dotted => {
+                for k in 0..5 {
+                    area.draw(&PathElement::new(vec![(x + 8 * k, y), (x + 8 * k + 3, y)], style))?;
+                }
+            }
+        }
+        area.draw(&Text::new(p.name, (x1 + 8, 10), font.clone()))?;
+        x += 250;
+    }
+    let note = if shown < total {
+        format!("1σ contours; one scale for all panels; {shown} of {total} steps shown")
+    } else {
+        "1σ contours; one scale for all panels".into()
+    };
+    area.draw(&Text::new(
+        note,
+        (x + 10, 10),
+        ("sans-serif", 13).into_font().color(&RGBColor(80, 80, 80)),
+    ))?;
+    Ok(())
 }
