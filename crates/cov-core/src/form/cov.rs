@@ -62,7 +62,7 @@ impl<const N: usize> Spectrum for Cov<N> {
         self.finish(op, old)
     }
 
-    #[inline]
+    #[inline(always)]
     fn raw_shear(&mut self, op: &str, i: usize, j: usize, s: f64) -> Result<(), CovError> {
         // Compute the new column j, check it, then commit: Σ is untouched on overflow.
         let mut col = [0.0; N];
@@ -87,16 +87,25 @@ impl<const N: usize> Spectrum for Cov<N> {
         Ok(())
     }
 
-    #[inline]
+    #[inline(always)]
     fn raw_scale(&mut self, op: &str, i: usize, c: f64) -> Result<(), CovError> {
-        let old = *self;
-        for k in 0..N {
-            let v = self.get(k, i) * c;
-            self.set(k, i, v);
+        // The new row/column i, checked before it is written: Σ is untouched on overflow.
+        let mut col = [0.0; N];
+        for (k, v) in col.iter_mut().enumerate() {
+            *v = self.get(k, i) * if k == i { c * c } else { c };
         }
-        let v = self.get(i, i) * c;
-        self.set(i, i, v);
-        self.finish(op, old)
+        if let Some(k) = col.iter().position(|v| !v.is_finite()) {
+            return Err(CovError::Overflow {
+                operator: op.into(),
+                row: k.min(i),
+                col: k.max(i),
+                value: col[k],
+            });
+        }
+        for (k, v) in col.iter().enumerate() {
+            self.set(k, i, *v);
+        }
+        Ok(())
     }
 
     #[inline]
@@ -120,7 +129,7 @@ impl<const N: usize> Spectrum for Cov<N> {
         self.finish(op, old)
     }
 
-    #[inline]
+    #[inline(always)]
     fn raw_add_variance(&mut self, op: &str, i: usize, w: f64) -> Result<(), CovError> {
         let v = self.get(i, i) + w;
         if !v.is_finite() {
@@ -135,7 +144,7 @@ impl<const N: usize> Spectrum for Cov<N> {
         Ok(())
     }
 
-    #[inline]
+    #[inline(always)]
     fn raw_lobe_1(&mut self, op: &str, p: usize, s: f64) -> Result<(), CovError> {
         if s == 0.0 {
             // Integration (or a diffuse lobe): a Schur complement of finite entries with a

@@ -263,6 +263,7 @@ impl<const N: usize> Spectrum for CovFactor<N> {
     }
 
     /// Row `j` += `s ×` row `i`.
+    #[inline]
     fn raw_shear(&mut self, op: &str, i: usize, j: usize, s: f64) -> Result<(), CovError> {
         let mut new = self.l;
         for c in 0..N {
@@ -272,6 +273,7 @@ impl<const N: usize> Spectrum for CovFactor<N> {
     }
 
     /// Row `i` times `c`.
+    #[inline]
     fn raw_scale(&mut self, op: &str, i: usize, c: f64) -> Result<(), CovError> {
         let mut new = self.l;
         for v in new[i].iter_mut() {
@@ -281,6 +283,7 @@ impl<const N: usize> Spectrum for CovFactor<N> {
     }
 
     /// Rows rotated in each plane (an orthogonal map: it cannot overflow).
+    #[inline]
     fn raw_rotate(&mut self, _op: &str, planes: &[(usize, usize)], c: f64, s: f64) -> Result<(), CovError> {
         for &(i, j) in planes {
             self.rotate_rows(i, j, c, s);
@@ -302,6 +305,7 @@ impl<const N: usize> Spectrum for CovFactor<N> {
     }
 
     /// A column `√w e_i` is appended and the factor folded back.
+    #[inline]
     fn raw_add_variance(&mut self, op: &str, i: usize, w: f64) -> Result<(), CovError> {
         let mut m = self.work();
         m[i][N] = w.sqrt();
@@ -309,6 +313,7 @@ impl<const N: usize> Spectrum for CovFactor<N> {
     }
 
     /// Potter's update along one axis.
+    #[inline]
     fn raw_lobe_1(&mut self, op: &str, p: usize, s: f64) -> Result<(), CovError> {
         let mut new = self.l;
         potter_axis(&mut new, p, s.max(0.0));
