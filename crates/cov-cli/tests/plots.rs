@@ -2,21 +2,13 @@
 //! axes, a legend; no system font is needed (DejaVu Sans is embedded). Pixel-exact output
 //! is not checked: dimensions, and dark (text) pixels where the title and legend stand.
 
-use std::path::{Path, PathBuf};
-use std::process::Command;
+use std::path::PathBuf;
 
-fn covtrace(args: &[&str]) -> std::process::Output {
-    Command::new(env!("CARGO_BIN_EXE_covtrace"))
-        .current_dir(Path::new(env!("CARGO_MANIFEST_DIR")).join("../.."))
-        .args(args)
-        .output()
-        .expect("run covtrace")
-}
+mod common;
+use common::covtrace;
 
 fn tmp(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("covtrace-plots-test-{}", std::process::id()));
-    std::fs::create_dir_all(&d).expect("temp dir");
-    d.join(name)
+    common::tmp("plots", name)
 }
 
 /// Dark pixels (luminance below 100) in the rectangle `x0..x1 × y0..y1`.

@@ -1,21 +1,13 @@
 //! `covtrace render`: the bundled scenes render at a small size and write every output;
 //! bad scene files give one positioned line and exit code 2, before any work.
 
-use std::path::{Path, PathBuf};
-use std::process::Command;
+use std::path::PathBuf;
 
-fn covtrace(args: &[&str]) -> std::process::Output {
-    Command::new(env!("CARGO_BIN_EXE_covtrace"))
-        .current_dir(Path::new(env!("CARGO_MANIFEST_DIR")).join("../.."))
-        .args(args)
-        .output()
-        .expect("run covtrace")
-}
+mod common;
+use common::covtrace;
 
 fn tmp(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("covtrace-render-test-{}", std::process::id()));
-    std::fs::create_dir_all(&d).expect("temp dir");
-    d.join(name)
+    common::tmp("render", name)
 }
 
 #[test]

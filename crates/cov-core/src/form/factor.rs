@@ -245,10 +245,7 @@ impl<const N: usize> Spectrum for CovFactor<N> {
         }
     }
     fn first_non_finite(&self) -> Option<(usize, usize, f64)> {
-        self.check_finite("").err().map(|e| match e {
-            CovError::Overflow { row, col, value, .. } => (row, col, value),
-            _ => (0, 0, f64::NAN),
-        })
+        super::overflow_at(self.check_finite(""))
     }
 
     /// `L' = Aᵀ L`.
