@@ -123,10 +123,21 @@ impl From<FormArg> for covtrace::Form {
 
 /// Prints a line; a closed pipe (`covtrace list | head`) is not an error.
 macro_rules! say {
-    ($($t:tt)*) => {{
-        use std::io::Write;
-        let _ = writeln!(std::io::stdout().lock(), $($t)*);
-    }};
+    ($($t:tt)*) => {
+        emit(&format!($($t)*))?
+    };
+}
+
+/// Writes a line to standard output. A closed pipe (`covtrace list | head`) ends the output
+/// quietly; any other failure (a full disk, `> /dev/full`) is an error.
+fn emit(line: &str) -> Result<(), String> {
+    use std::io::Write;
+    let mut out = std::io::stdout().lock();
+    match writeln!(out, "{line}").and_then(|()| out.flush()) {
+        Ok(()) => Ok(()),
+        Err(e) if e.kind() == std::io::ErrorKind::BrokenPipe => Ok(()),
+        Err(e) => Err(format!("cannot write the output: {e}")),
+    }
 }
 
 fn main() -> ExitCode {
@@ -196,7 +207,8 @@ fn run(cli: Cli) -> Result<(), String> {
             say!("{}", report::header());
             let rows = report::run(&sizes, |r| {
                 if bar.is_hidden() {
-                    say!("{}", report::line(r));
+                    // A failed write shows at the next line printed outside this callback.
+                    let _ = emit(&report::line(r));
                 } else {
                     bar.println(report::line(r));
                 }

@@ -36,6 +36,6 @@ mod source;
 
 pub use error::PathError;
 pub use eval::{EvalStep, Evaluation, StepReport};
-pub use path::{Path, ron_options};
+pub use path::{MAX_PATH_BYTES, Path, ron_options};
 pub use registry::{Entry, Registry};
 pub use source::Source;

@@ -71,17 +71,42 @@ impl Path {
         Ok(path)
     }
 
-    /// Reads and parses a file.
+    /// Reads and parses a file (`-`: standard input), at most [`MAX_PATH_BYTES`] bytes of
+    /// UTF-8 text (a leading byte-order mark is skipped).
     ///
     /// # Errors
-    /// [`PathError::Io`] or [`PathError::Parse`] naming the file.
+    /// [`PathError::Io`] (unreadable, too large), [`PathError::Parse`] (not UTF-8, with the
+    /// line and column of the first bad byte; malformed RON), naming the file.
     pub fn load(file: &std::path::Path, registry: &Registry) -> Result<Path, PathError> {
-        let name = file.display().to_string();
-        let text = std::fs::read_to_string(file).map_err(|e| PathError::Io {
+        use std::io::Read;
+        let stdin = file.as_os_str() == "-";
+        let name = if stdin {
+            "<stdin>".to_string()
+        } else {
+            file.display().to_string()
+        };
+        let io = |message: String| PathError::Io {
             file: name.clone(),
-            message: e.to_string(),
-        })?;
-        Self::parse_named(&text, &name, registry)
+            message,
+        };
+        let mut bytes = Vec::new();
+        let read = if stdin {
+            std::io::stdin()
+                .lock()
+                .take(MAX_PATH_BYTES + 1)
+                .read_to_end(&mut bytes)
+        } else {
+            std::fs::File::open(file).and_then(|f| f.take(MAX_PATH_BYTES + 1).read_to_end(&mut bytes))
+        };
+        read.map_err(|e| io(e.to_string()))?;
+        if bytes.len() as u64 > MAX_PATH_BYTES {
+            return Err(io(format!(
+                "more than {MAX_PATH_BYTES} bytes; path files are read up to {} MiB",
+                MAX_PATH_BYTES >> 20
+            )));
+        }
+        let text = utf8(&bytes, &name)?;
+        Self::parse_named(text.strip_prefix('\u{feff}').unwrap_or(text), &name, registry)
     }
 
     /// Union of what the source and every operator need.
@@ -136,6 +161,33 @@ impl Path {
         }
         Ok((n, false))
     }
+}
+
+/// Largest path file read (bytes): 16 MiB, far above any hand-written or generated path
+/// (a 10⁶-operator path is about 25 MB of `Travel(distance: 1.0)`: split it).
+pub const MAX_PATH_BYTES: u64 = 16 << 20;
+
+/// `bytes` as UTF-8, or a parse error at the line and column of the first invalid byte.
+fn utf8<'a>(bytes: &'a [u8], name: &str) -> Result<&'a str, PathError> {
+    std::str::from_utf8(bytes).map_err(|e| {
+        let good = std::str::from_utf8(&bytes[..e.valid_up_to()]).unwrap_or("");
+        let line = good.matches('\n').count() + 1;
+        let col = good.rsplit('\n').next().map_or(0, |l| l.chars().count()) + 1;
+        let utf16 = bytes.starts_with(&[0xFF, 0xFE]) || bytes.starts_with(&[0xFE, 0xFF]);
+        PathError::Parse {
+            file: name.to_string(),
+            line,
+            col,
+            message: if utf16 {
+                "the file is UTF-16 text; path files are UTF-8".into()
+            } else {
+                format!(
+                    "not UTF-8 text: byte 0x{:02X} cannot start or continue a character",
+                    bytes[e.valid_up_to()]
+                )
+            },
+        }
+    })
 }
 
 /// The axis names of layout `n`, comma-separated.
