@@ -1,4 +1,6 @@
 //! Shared by the CLI tests: running the binary from the workspace root, temporary files.
+//! Each test file uses what it needs (hence `dead_code`: a file may not use every helper).
+#![allow(dead_code)]
 
 use std::path::{Path, PathBuf};
 use std::process::Command;
