@@ -16,7 +16,7 @@ pub enum CovError {
         value: f64,
     },
     /// A parameter is finite but outside its domain.
-    #[error("{operator}: parameter `{parameter}` = {value} is out of range: {expected}")]
+    #[error("{operator}: parameter `{parameter}` = {} is out of range: {expected}", num(*value))]
     OutOfRange {
         /// Operator or function that rejected the value.
         operator: String,
@@ -46,7 +46,7 @@ pub enum CovError {
         got: String,
     },
     /// A matrix given as a covariance is not symmetric.
-    #[error("matrix is not symmetric: entry ({row},{col}) = {a} but ({col},{row}) = {b}")]
+    #[error("matrix is not symmetric: entry ({row},{col}) = {} but ({col},{row}) = {}", num(*a), num(*b))]
     NotSymmetric {
         /// Row of the offending entry.
         row: usize,
@@ -101,6 +101,18 @@ pub enum CovError {
         /// The error it returned.
         source: Box<CovError>,
     },
+}
+
+/// A number as messages print it: plainly between `1e-4` and `1e6` (`0.25`, `1500`),
+/// else in scientific form with the fewest digits that read back exactly (`1e300`,
+/// `3.2e-9`), so that no message prints a 300-digit decimal.
+pub fn num(v: f64) -> String {
+    let a = v.abs();
+    if v == 0.0 || !v.is_finite() || (1e-4..1e6).contains(&a) {
+        format!("{v}")
+    } else {
+        format!("{v:e}")
+    }
 }
 
 impl CovError {

@@ -142,6 +142,13 @@ pub struct Sensor {
     pitch: f64,
 }
 
+/// Largest Nyquist factor a sensor accepts.
+pub const MAX_NYQUIST: f64 = 1e3;
+/// Largest reconstruction filter std a sensor accepts (px).
+pub const MAX_FILTER_PX: f64 = 1e6;
+/// Largest aperture (m) or shutter (s) std a sensor accepts.
+pub const MAX_EXTENT: f64 = 1e6;
+
 /// What a renderer needs per pixel (see the crate docs).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct PixelDecisions {
@@ -189,13 +196,40 @@ impl Sensor {
         )?;
         CovError::require_positive(Self::NAME, "distance", p.distance)?;
         CovError::require_positive(Self::NAME, "filter", p.filter)?;
-        CovError::require_positive(Self::NAME, "nyquist", p.nyquist)?;
-        CovError::require_positive(Self::NAME, "max_filter", p.max_filter)?;
+        // Bounds far beyond any use, so that no decision overflows f64 (a squared
+        // `max_filter` of 1e155 px would, and silently gave a filter of 0 px).
+        let within = |v: f64, hi: f64| v > 0.0 && v <= hi;
+        CovError::require_range(
+            Self::NAME,
+            "nyquist",
+            p.nyquist,
+            |v| within(v, MAX_NYQUIST),
+            "must be in (0, 1e3]",
+        )?;
+        CovError::require_range(
+            Self::NAME,
+            "max_filter",
+            p.max_filter,
+            |v| within(v, MAX_FILTER_PX),
+            "must be in (0, 1e6] px",
+        )?;
         if let Some(a) = p.aperture {
-            CovError::require_positive(Self::NAME, "aperture", a)?;
+            CovError::require_range(
+                Self::NAME,
+                "aperture",
+                a,
+                |v| within(v, MAX_EXTENT),
+                "must be in (0, 1e6] m",
+            )?;
         }
         if let Some(s) = p.shutter {
-            CovError::require_positive(Self::NAME, "shutter", s)?;
+            CovError::require_range(
+                Self::NAME,
+                "shutter",
+                s,
+                |v| within(v, MAX_EXTENT),
+                "must be in (0, 1e6] s",
+            )?;
         }
         let pitch = 2.0 * p.distance * (0.5 * p.fov_x).tan() / f64::from(p.width);
         CovError::require_positive(Self::NAME, "pitch", pitch)?;
@@ -284,6 +318,17 @@ impl Sensor {
             sampled_axes.push("t".into());
         }
         let n = filter.extents.len();
+        if !(density.is_finite()
+            && (density * span).is_finite()
+            && filter.extents.iter().all(|v| v.is_finite()))
+        {
+            return Err(CovError::NoTransport {
+                operator: Self::NAME.into(),
+                reason: format!(
+                    "the sampling density overflows f64 (density {density:e}, over a domain of {span:e}): Σ at the sensor is beyond what a renderer can sample"
+                ),
+            });
+        }
         Ok(PixelDecisions {
             image_axes: image_axes.iter().map(|a| a.name().to_string()).collect(),
             image_bandwidth_px: image_cov_px
