@@ -105,11 +105,21 @@ impl<const N: usize> Spectrum for Cov<N> {
         Ok(())
     }
 
-    #[inline]
+    #[inline(always)]
     fn raw_rotate(&mut self, op: &str, planes: &[(usize, usize)], c: f64, s: f64) -> Result<(), CovError> {
         let old = *self;
-        for &(i, j) in planes {
-            self.rotate_idx(i, j, c, s);
+        // One or two planes written out, so that constant indices reach `rotate_idx`.
+        match *planes {
+            [(i, j)] => self.rotate_idx(i, j, c, s),
+            [(i, j), (k, l)] => {
+                self.rotate_idx(i, j, c, s);
+                self.rotate_idx(k, l, c, s);
+            }
+            _ => {
+                for &(i, j) in planes {
+                    self.rotate_idx(i, j, c, s);
+                }
+            }
         }
         self.finish(op, old)
     }
