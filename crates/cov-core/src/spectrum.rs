@@ -380,6 +380,7 @@ pub(crate) fn block_from_slice(op: &str, name: &str, k: usize, w: &[f64]) -> Res
 }
 
 /// The indices of `axes` in layout `n` (at most `n`, distinct), for kernel `op`.
+#[inline]
 pub(crate) fn resolve(n: usize, op: &str, axes: &[Axis]) -> Result<([usize; MAX], usize), CovError> {
     let mut idx = [0usize; MAX];
     if axes.is_empty() || axes.len() > n {
