@@ -54,46 +54,10 @@ enum Command {
     List,
     /// Check the covariance pass against a reference render: the local spectrum of each
     /// 16×16 tile against the predicted bandwidth.
-    RenderCheck {
-        /// The scene file.
-        scene: PathBuf,
-        /// Samples per pixel of the reference.
-        #[arg(long, default_value_t = 256)]
-        ref_spp: u32,
-        /// Covariance paths per pixel.
-        #[arg(long, default_value_t = 8)]
-        cov_paths: u32,
-        /// Render at this size instead of the scene's (`WIDTHxHEIGHT`).
-        #[arg(long)]
-        size: Option<String>,
-        /// Seed.
-        #[arg(long, default_value_t = 1)]
-        seed: u64,
-        /// Write the per-tile comparison as JSON.
-        #[arg(long)]
-        json: Option<PathBuf>,
-    },
+    RenderCheck(cov_cli::render::CheckArgs),
     /// Render a scene (RON) with uniform sampling; also writes the covariance pass's
     /// density and filter maps.
-    Render {
-        /// The scene file.
-        scene: PathBuf,
-        /// Samples per pixel.
-        #[arg(long, default_value_t = 16)]
-        spp: u32,
-        /// Output EXR (linear); a PNG and the maps are written beside it.
-        #[arg(short, long, default_value = "render.exr")]
-        output: PathBuf,
-        /// Covariance paths per pixel (0: skip the covariance pass).
-        #[arg(long, default_value_t = 4)]
-        cov_paths: u32,
-        /// Seed of the random numbers (the image does not depend on the thread count).
-        #[arg(long, default_value_t = 1)]
-        seed: u64,
-        /// Render at this size instead of the scene's (`WIDTHxHEIGHT`, e.g. `640x480`).
-        #[arg(long)]
-        size: Option<String>,
-    },
+    Render(cov_cli::render::RenderArgs),
     /// The stiff suite: extreme chains in both forms and plain f64 against a
     /// double-double reference.
     Stiff {
@@ -234,44 +198,8 @@ fn run(cli: Cli) -> Result<(), String> {
             bar.finish_and_clear();
             say!("{}", cov_stiff::report(&outcomes).trim_end());
         }
-        Command::Render {
-            scene,
-            spp,
-            output,
-            cov_paths,
-            seed,
-            size,
-        } => {
-            let size = size.map(|s| cov_cli::render::parse_size(&s)).transpose()?;
-            let text = cov_cli::render::run(&cov_cli::render::RenderArgs {
-                scene,
-                spp,
-                output,
-                cov_paths,
-                seed,
-                size,
-            })?;
-            say!("{}", text.trim_end());
-        }
-        Command::RenderCheck {
-            scene,
-            ref_spp,
-            cov_paths,
-            size,
-            seed,
-            json,
-        } => {
-            let size = size.map(|s| cov_cli::render::parse_size(&s)).transpose()?;
-            let text = cov_cli::render::check(&cov_cli::render::CheckArgs {
-                scene,
-                ref_spp,
-                cov_paths,
-                size,
-                seed,
-                json,
-            })?;
-            say!("{}", text.trim_end());
-        }
+        Command::Render(args) => say!("{}", cov_cli::render::run(&args)?.trim_end()),
+        Command::RenderCheck(args) => say!("{}", cov_cli::render::check(&args)?.trim_end()),
         Command::List => {
             for e in registry.entries() {
                 say!("{}: {}", e.name, e.summary);

@@ -8,19 +8,25 @@ use cov_render::render::{
 use cov_render::{MAX_COV_PATHS, MAX_SPP, World};
 use indicatif::{ProgressBar, ProgressStyle};
 
-/// What `covtrace render` was asked.
+/// What `covtrace render` was asked (parsed by clap).
+#[derive(Clone, Debug, clap::Args)]
 pub struct RenderArgs {
     /// The scene file.
     pub scene: PathBuf,
     /// Samples per pixel.
+    #[arg(long, default_value_t = 16)]
     pub spp: u32,
-    /// Output EXR; the PNG and maps are written beside it.
+    /// Output EXR (linear); a PNG and the maps are written beside it.
+    #[arg(short, long, default_value = "render.exr")]
     pub output: PathBuf,
-    /// Covariance paths per pixel (0: no covariance pass).
+    /// Covariance paths per pixel (0: skip the covariance pass).
+    #[arg(long, default_value_t = 4)]
     pub cov_paths: u32,
-    /// Seed.
+    /// Seed of the random numbers (the image does not depend on the thread count).
+    #[arg(long, default_value_t = 1)]
     pub seed: u64,
-    /// A size overriding the scene's (width, height).
+    /// Render at this size instead of the scene's (`WIDTHxHEIGHT`, e.g. `640x480`).
+    #[arg(long, value_parser = parse_size)]
     pub size: Option<(u32, u32)>,
 }
 
@@ -156,19 +162,25 @@ pub fn run(a: &RenderArgs) -> Result<String, String> {
     Ok(out)
 }
 
-/// What `covtrace render-check` was asked.
+/// What `covtrace render-check` was asked (parsed by clap).
+#[derive(Clone, Debug, clap::Args)]
 pub struct CheckArgs {
     /// The scene file.
     pub scene: PathBuf,
-    /// Samples per pixel of the reference.
+    /// Samples per pixel of each of the two references.
+    #[arg(long, default_value_t = 256)]
     pub ref_spp: u32,
     /// Covariance paths per pixel.
+    #[arg(long, default_value_t = 8)]
     pub cov_paths: u32,
-    /// A size overriding the scene's.
+    /// Render at this size instead of the scene's (`WIDTHxHEIGHT`).
+    #[arg(long, value_parser = parse_size)]
     pub size: Option<(u32, u32)>,
     /// Seed.
+    #[arg(long, default_value_t = 1)]
     pub seed: u64,
-    /// Where to write the per-tile JSON (optional).
+    /// Write the per-tile comparison as JSON.
+    #[arg(long)]
     pub json: Option<PathBuf>,
 }
 
