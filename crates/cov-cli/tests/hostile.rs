@@ -50,3 +50,20 @@ fn a_failed_write_is_an_error() {
     assert_eq!(o.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&o.stderr).contains("cannot write the output"));
 }
+
+#[test]
+fn the_largest_count_a_user_may_give_is_bounded_work() {
+    // The largest slice count allowed evaluates at once; a larger one is refused before
+    // any work (it used to run for minutes).
+    let ron = common::tmp("hostile", "slices.ron");
+    std::fs::write(
+        &ron,
+        "Path(source: Gaussian(x: 0.1), operators: [ThickOccluder(depth: 0.3, slices: 10000, std: 0.05)])",
+    )
+    .expect("write");
+    let t = std::time::Instant::now();
+    let o = covtrace(&["eval", ron.to_str().expect("utf-8")]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    // Not a timing test: a bound far above the measured few milliseconds, to catch a hang.
+    assert!(t.elapsed().as_secs() < 60);
+}

@@ -18,7 +18,7 @@
 //! |  | `sxy` | (cycles/m)² | optional | Spectrum covariance xy, `\|sxy\| ≤ √(sxx·syy)` (0 when left out). |
 //! |  | `syy` | (cycles/m)² | optional | Spectrum covariance yy, ≥ 0 (`sxx` when left out). |
 //! | `ThickOccluder` | `depth` | m | required | Depth of the occluder along the ray, ≥ 0. |
-//! |  | `slices` | – | required | Number of slices, ≥ 1. |
+//! |  | `slices` | – | required | Number of slices, 1 to 10000. |
 //! |  | `std` | m | required | Window std of each slice, > 0. |
 //! <!-- end of parameters -->
 //!
@@ -69,9 +69,21 @@ use cov_core::{Axis, CovError, FOUR_PI_SQ, Operator, Spectrum};
 fn window_var(op: &str, name: &str, std: f64) -> Result<f64, CovError> {
     CovError::require_positive(op, name, std)?;
     let w = 1.0 / (FOUR_PI_SQ * std * std);
-    CovError::require_range(op, name, w, f64::is_finite, "too small: 1/(4π² s²) overflows")?;
+    // Reported on the user's std, not on the derived variance (which is what overflows).
+    CovError::require_range(
+        op,
+        name,
+        std,
+        |_| w.is_finite(),
+        "too small: the window's spectrum variance 1/(4π² s²) overflows f64 (s must be above about 1e-153 m)",
+    )?;
     Ok(w)
 }
+
+/// Most slices a [`ThickOccluder`] is cut into: each slice is a window and a travel, so
+/// this bounds the work of one operator (finer slicing changes nothing measurable: the
+/// slices' windows add up to the occluder's).
+pub const MAX_SLICES: u32 = 10_000;
 
 /// A Gaussian window across the ray: `w(x, y) = exp(−x²/2s_x² − y²/2s_y²)`.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -215,12 +227,16 @@ impl ThickOccluder {
     /// Negative or non-finite `depth`, `slices == 0`, invalid `std`.
     pub fn new(depth: f64, slices: u32, std: f64) -> Result<Self, CovError> {
         CovError::require_non_negative(Self::NAME, "depth", depth)?;
-        if slices == 0 {
+        if slices == 0 || slices > MAX_SLICES {
             return Err(CovError::OutOfRange {
                 operator: Self::NAME.into(),
                 parameter: "slices".into(),
-                value: 0.0,
-                expected: "must be ≥ 1".into(),
+                value: f64::from(slices),
+                expected: if slices == 0 {
+                    "must be ≥ 1".into()
+                } else {
+                    format!("must be at most {MAX_SLICES}")
+                },
             });
         }
         let w = window_var(Self::NAME, "std", std)?;

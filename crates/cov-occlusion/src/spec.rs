@@ -81,7 +81,7 @@ pub struct ThickOccluderSpec {
     /// Depth of the occluder along the ray, ≥ 0.
     #[param(unit = "m")]
     pub depth: f64,
-    /// Number of slices, ≥ 1.
+    /// Number of slices, 1 to 10000.
     pub slices: u32,
     /// Window std of each slice, > 0.
     #[param(unit = "m")]

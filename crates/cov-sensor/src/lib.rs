@@ -233,6 +233,15 @@ impl Sensor {
         }
         let pitch = 2.0 * p.distance * (0.5 * p.fov_x).tan() / f64::from(p.width);
         CovError::require_positive(Self::NAME, "pitch", pitch)?;
+        // The pixel filter's window, reported on the user's `filter` when it overflows.
+        let s = p.filter * pitch;
+        CovError::require_range(
+            Self::NAME,
+            "filter",
+            p.filter,
+            |_| (1.0 / (FOUR_PI_SQ * s * s)).is_finite(),
+            "too small: the pixel filter's spectrum variance overflows f64",
+        )?;
         Ok(Sensor { p, pitch })
     }
 
