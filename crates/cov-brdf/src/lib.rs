@@ -25,13 +25,16 @@
 //! |  | `cos_out` | – | required | `\|cos θ_out\|`, in (0, 1]. |
 //! |  | `curvature` | 1/m | optional | Surface curvature, `(k: …)` or `(kx: …, ky: …, angle: …)`; flat when left out. |
 //! |  | `lobe` | – | required | The lobe, as in `Brdf`. |
+//! |  | `turn` | rad | optional | Turn of the surface frame from the plane of incidence to the outgoing ray's (3D). |
 //! <!-- end of parameters -->
 //!
 //! Zero roughness is the mirror, exactly. Anisotropic roughness is along the frame's
 //! `u` and `v` (rotate the frame first with cov-projection's `RotateFrame`).
 //!
 //! [`Reflect`] is the composite reflection at a curved surface, in order: projection
-//! (`cos_in`), curvature, mirror symmetry, lobe, inverse curvature, inverse projection
+//! (`cos_in`), curvature, mirror symmetry, lobe, a turn of the surface frame by `turn`
+//! (rule 1, a rotation of `(x, y)` and `(u, v)`: from the plane of incidence to the plane of
+//! the outgoing ray, 0 when they coincide), inverse curvature, inverse projection
 //! (`cos_out`); the frame's `x` must lie in the plane of incidence.
 //!
 //! **Surface frame convention.** Rays carry `u` in the direction of propagation (travel is
@@ -76,6 +79,9 @@
 //! let path = cov_path::Path::parse(text, &registry)?;
 //! let result = path.eval()?;
 //! assert_eq!(result.layout, 2); // inferred from what the operators need
+//! // An outgoing ray out of the plane of incidence: the turn needs the 3D frame.
+//! let turned = "Path(source: Gaussian(x: 0.1), operators: [Reflect(cos_in: 0.8, cos_out: 0.6, lobe: Diffuse, turn: 0.3)])";
+//! assert_eq!(cov_path::Path::parse(turned, &registry)?.eval()?.layout, 4);
 //! # Ok::<(), cov_path::PathError>(())
 //! ```
 #![warn(missing_docs)]
@@ -249,13 +255,16 @@ impl Operator for Brdf {
     }
 }
 
-/// Reflection at a curved surface: projection, curvature, mirror symmetry, lobe, inverse
-/// curvature, inverse projection to the outgoing direction.
+/// Reflection at a curved surface: projection, curvature, mirror symmetry, lobe, a turn of
+/// the surface frame from the plane of incidence to the plane of the outgoing ray (0 when
+/// the outgoing ray lies in the plane of incidence), inverse curvature, inverse projection
+/// to the outgoing direction.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Reflect {
     project: Project,
     curvature: Curvature,
     lobe: Lobe,
+    turn: f64,
     unproject: Unproject,
 }
 
@@ -266,10 +275,28 @@ impl Reflect {
     /// # Errors
     /// `cos_in`, `cos_out` not in (0, 1]; invalid lobe.
     pub fn new(cos_in: f64, cos_out: f64, curvature: Curvature, lobe: Lobe) -> Result<Self, CovError> {
+        Self::with_turn(cos_in, cos_out, curvature, lobe, 0.0)
+    }
+
+    /// Reflection whose outgoing ray leaves the plane of incidence: after the lobe, the
+    /// surface frame turns by `turn` (rad, about the normal, from the incident plane's
+    /// tangent towards the outgoing plane's) before the inverse curvature and projection.
+    /// A renderer computes it from the two directions; `turn = 0` is [`Reflect::new`].
+    ///
+    /// # Errors
+    /// As [`Reflect::new`]; a non-finite `turn`.
+    pub fn with_turn(
+        cos_in: f64,
+        cos_out: f64,
+        curvature: Curvature,
+        lobe: Lobe,
+        turn: f64,
+    ) -> Result<Self, CovError> {
         Ok(Reflect {
             project: Project::new(cos_in)?,
             curvature,
             lobe: lobe.validated()?,
+            turn: CovError::require_finite(Self::NAME, "turn", turn)?,
             unproject: Unproject::new(cos_out)?,
         })
     }
@@ -283,10 +310,18 @@ impl Operator for Reflect {
         self.curvature.apply_oblique(cov, self.project.cos(), 1.0)?;
         Operator::apply(&Mirror, cov)?;
         self.lobe.apply_to(cov)?;
+        if self.turn != 0.0 {
+            cov.rotate_frame(self.turn)?;
+        }
         self.curvature.apply_oblique(cov, self.unproject.cos(), -1.0)?;
         Operator::apply(&self.unproject, cov)
     }
     fn requires(&self) -> cov_core::AxisSet {
-        Operator::requires(&self.curvature)
+        let r = Operator::requires(&self.curvature);
+        if self.turn != 0.0 {
+            r.union(cov_core::AxisSet::SPACE)
+        } else {
+            r
+        }
     }
 }

@@ -34,16 +34,20 @@ pub struct ReflectSpec {
     pub curvature: CurvatureSpec,
     /// The lobe, as in `Brdf`.
     pub lobe: Lobe,
+    /// Turn of the surface frame from the plane of incidence to the outgoing ray's (3D).
+    #[param(unit = "rad", default)]
+    pub turn: f64,
 }
 
 impl TryFrom<ReflectSpec> for Reflect {
     type Error = CovError;
     fn try_from(spec: ReflectSpec) -> Result<Reflect, CovError> {
-        Reflect::new(
+        Reflect::with_turn(
             spec.cos_in,
             spec.cos_out,
             spec.curvature.to_curvature()?,
             spec.lobe,
+            spec.turn,
         )
     }
 }

@@ -135,3 +135,42 @@ fn extreme_phong_exponents() {
         assert!(q.validity().is_valid(), "e={e}: {}", q.validity());
     }
 }
+
+/// `Reflect::with_turn`, checked by properties that do not restate its code: a turn of π
+/// changes no Σ (it negates every axis), and at normal incidence with isotropic curvature
+/// and lobe the steps after the lobe commute with the turn, so it equals `Reflect` then
+/// `RotateFrame`.
+#[test]
+fn reflect_turn_between_planes_of_incidence() {
+    use cov_core::{Cov, Operator};
+    use cov_projection::RotateFrame;
+    let start = Cov::<4>::from_matrix(&nalgebra::SMatrix::<f64, 4, 4>::from_fn(|i, j| {
+        [
+            [3.0, 0.4, -1.0, 0.2],
+            [0.4, 2.0, 0.3, -0.5],
+            [-1.0, 0.3, 4.0, 0.6],
+            [0.2, -0.5, 0.6, 1.5],
+        ][i][j]
+    }))
+    .unwrap();
+    let k = Curvature::isotropic(1.5).unwrap();
+    let lobe = Lobe::phong(40.0).unwrap();
+    let run = |op: &dyn Operator| {
+        let mut c = start;
+        op.apply(&mut c).unwrap();
+        c
+    };
+    let plain = run(&Reflect::new(0.7, 0.8, k, lobe).unwrap());
+    let half_turn = run(&Reflect::with_turn(0.7, 0.8, k, lobe, std::f64::consts::PI).unwrap());
+    assert!((plain.to_matrix() - half_turn.to_matrix()).norm() <= 1e-12 * plain.norm());
+    let turned = run(&Reflect::with_turn(1.0, 1.0, k, lobe, 0.4).unwrap());
+    let mut then_rotated = run(&Reflect::new(1.0, 1.0, k, lobe).unwrap());
+    RotateFrame::new(0.4).unwrap().apply(&mut then_rotated).unwrap();
+    assert!((turned.to_matrix() - then_rotated.to_matrix()).norm() <= 1e-12 * turned.norm());
+    assert!(Reflect::with_turn(0.7, 0.8, k, lobe, f64::NAN).is_err());
+    // A turn needs the 3D frame.
+    assert_eq!(
+        Operator::requires(&Reflect::with_turn(0.7, 0.8, k, lobe, 0.4).unwrap()).smallest_layout(),
+        4
+    );
+}

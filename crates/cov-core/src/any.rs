@@ -373,14 +373,6 @@ impl AnySpectrum {
         }
     }
 
-    /// The layout size N.
-    pub fn dim(&self) -> usize {
-        match self {
-            AnySpectrum::Covariance(c) => c.dim(),
-            AnySpectrum::SquareRoot(f) => each!(AnyFactor, f, f => f.dim()),
-        }
-    }
-
     /// Σ now.
     ///
     /// # Errors

@@ -115,6 +115,37 @@ pub fn num(v: f64) -> String {
     }
 }
 
+/// Longest piece of user input echoed in a message (characters).
+pub const ECHO_MAX: usize = 64;
+
+/// User input as messages echo it: cut to [`ECHO_MAX`] characters with `…` and its length
+/// when longer, so that a 50 MB name never becomes a 50 MB error line.
+pub fn echo(s: &str) -> String {
+    if s.chars().count() <= ECHO_MAX {
+        s.to_string()
+    } else {
+        let cut: String = s.chars().take(ECHO_MAX).collect();
+        format!("{cut}… ({} characters)", s.chars().count())
+    }
+}
+
+/// Line and column (1-based, columns in characters) of the end of `before`: the position
+/// of whatever follows it, for messages about text files.
+pub fn line_col(before: &str) -> (usize, usize) {
+    let line = before.matches('\n').count() + 1;
+    let col = before.rsplit('\n').next().map_or(0, |l| l.chars().count()) + 1;
+    (line, col)
+}
+
+/// Where `bytes` stop being UTF-8: line and column of the first invalid byte, and that byte
+/// (`None` when all of it is UTF-8).
+pub fn utf8_error_at(bytes: &[u8]) -> Option<(usize, usize, u8)> {
+    let e = std::str::from_utf8(bytes).err()?;
+    let good = std::str::from_utf8(&bytes[..e.valid_up_to()]).unwrap_or("");
+    let (line, col) = line_col(good);
+    Some((line, col, bytes[e.valid_up_to()]))
+}
+
 impl CovError {
     /// Checks that `value` is finite; the error names the operator and parameter.
     ///

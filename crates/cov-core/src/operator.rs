@@ -184,11 +184,6 @@ impl Chain {
         self.steps.iter().map(|b| b.as_ref())
     }
 
-    /// The operators as shared handles, in order.
-    pub fn shared(&self) -> &[Arc<dyn Operator>] {
-        &self.steps
-    }
-
     /// Names joined with `+` (for an enclosing operator's name).
     pub fn names(&self) -> String {
         self.steps
@@ -271,13 +266,6 @@ impl Chain {
         }
         Ok(Trace { start, steps })
     }
-
-    /// The union of what the steps need.
-    pub fn requires_all(&self) -> AxisSet {
-        self.steps
-            .iter()
-            .fold(AxisSet::FLAT, |s, op| s.union(op.requires()))
-    }
 }
 
 fn step_error(index: usize, op: &dyn Operator, e: CovError) -> CovError {
@@ -319,8 +307,11 @@ impl Operator for Chain {
         "Chain"
     }
 
+    /// The union of what the steps need.
     fn requires(&self) -> AxisSet {
-        self.requires_all()
+        self.steps
+            .iter()
+            .fold(AxisSet::FLAT, |s, op| s.union(op.requires()))
     }
 }
 

@@ -217,8 +217,8 @@ impl<'de, R: OperatorReader> DeserializeSeed<'de> for NestedSeed<'_, R> {
     }
 }
 
-/// The seed the derive uses for field names (identifiers).
-#[doc(hidden)]
+/// A serde seed that reads an identifier (a field or variant name) as a string: used by
+/// the derive for parameter names and by format crates for operator and field names.
 pub struct FieldName;
 
 impl<'de> DeserializeSeed<'de> for FieldName {
@@ -235,18 +235,5 @@ impl Visitor<'_> for FieldName {
     }
     fn visit_str<E: serde::de::Error>(self, v: &str) -> Result<String, E> {
         Ok(v.to_string())
-    }
-}
-
-/// An [`OperatorReader`] for specs read where nesting is not allowed: every nested list
-/// is an error.
-#[derive(Clone, Copy, Debug, Default)]
-pub struct NoNesting;
-
-impl OperatorReader for NoNesting {
-    fn read_operators<'de, D: Deserializer<'de>>(&self, _d: D) -> Result<Chain, D::Error> {
-        Err(serde::de::Error::custom(
-            "nested operator lists are not read here",
-        ))
     }
 }

@@ -166,7 +166,7 @@ impl Operator for Moving {
         self.frame.shear(cov, -1.0)
     }
     fn requires(&self) -> AxisSet {
-        self.frame.requires().union(self.operators.requires_all())
+        self.frame.requires().union(self.operators.requires())
     }
 }
 

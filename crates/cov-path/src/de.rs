@@ -5,7 +5,8 @@ use std::cell::Cell;
 use std::fmt;
 use std::sync::Arc;
 
-use cov_core::{Chain, Operator, OperatorReader, layout_set};
+use cov_core::spec::FieldName;
+use cov_core::{Chain, Operator, OperatorReader, echo, layout_set};
 use serde::de::{
     self, DeserializeSeed, Deserializer, EnumAccess, MapAccess, SeqAccess, VariantAccess, Visitor,
 };
@@ -14,19 +15,6 @@ use crate::path::{Path, axes_string};
 use crate::registry::{Entry, Registry};
 use crate::scan::Element;
 use crate::source::Source;
-
-/// Longest piece of user input echoed in a message (characters); longer names are cut.
-pub(crate) const ECHO_MAX: usize = 64;
-
-/// `s`, cut to [`ECHO_MAX`] characters with `…` when longer.
-pub(crate) fn echo(s: &str) -> String {
-    if s.chars().count() <= ECHO_MAX {
-        s.to_string()
-    } else {
-        let cut: String = s.chars().take(ECHO_MAX).collect();
-        format!("{cut}… ({} characters)", s.chars().count())
-    }
-}
 
 /// The parse context: the registry, what the scan saw of each operator element, and
 /// the rules that span elements (one sensor, at the end of the top-level list).
@@ -64,26 +52,6 @@ impl OperatorReader for Reader<'_> {
     }
 }
 
-/// Reads a bare identifier (a variant or field name) as a string.
-struct Ident;
-
-impl<'de> DeserializeSeed<'de> for Ident {
-    type Value = String;
-    fn deserialize<D: Deserializer<'de>>(self, d: D) -> Result<String, D::Error> {
-        d.deserialize_identifier(self)
-    }
-}
-
-impl Visitor<'_> for Ident {
-    type Value = String;
-    fn expecting(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str("a name")
-    }
-    fn visit_str<E: de::Error>(self, v: &str) -> Result<String, E> {
-        Ok(v.to_string())
-    }
-}
-
 /// First pass: reads `layout` only.
 pub(crate) struct LayoutProbe;
 
@@ -103,7 +71,7 @@ impl<'de> Visitor<'de> for LayoutProbe {
     }
     fn visit_map<A: MapAccess<'de>>(self, mut map: A) -> Result<Option<usize>, A::Error> {
         let mut layout = None;
-        while let Some(key) = map.next_key_seed(Ident)? {
+        while let Some(key) = map.next_key_seed(FieldName)? {
             if key == "layout" {
                 layout = Some(map.next_value::<usize>()?);
             } else {
@@ -138,7 +106,7 @@ impl<'de> Visitor<'de> for PathSeed<'_, '_> {
         let mut layout: Option<usize> = None;
         let mut source: Option<Source> = None;
         let mut operators: Option<Vec<Arc<dyn Operator>>> = None;
-        while let Some(key) = map.next_key_seed(Ident)? {
+        while let Some(key) = map.next_key_seed(FieldName)? {
             match key.as_str() {
                 "layout" => {
                     if layout.is_some() {
@@ -247,7 +215,7 @@ impl<'de> Visitor<'de> for OpSeed<'_, '_> {
         let ordinal = reader.next.get();
         reader.next.set(ordinal + 1);
         let bare = reader.elements.get(ordinal).map(|e| e.bare);
-        let (name, variant) = data.variant_seed(Ident)?;
+        let (name, variant) = data.variant_seed(FieldName)?;
         let Some(entry) = reader.registry.get(&name) else {
             return Err(de::Error::custom(format!(
                 "unknown operator `{}`; known operators: {}",

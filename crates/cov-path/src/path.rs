@@ -169,10 +169,8 @@ pub const MAX_PATH_BYTES: u64 = 16 << 20;
 
 /// `bytes` as UTF-8, or a parse error at the line and column of the first invalid byte.
 fn utf8<'a>(bytes: &'a [u8], name: &str) -> Result<&'a str, PathError> {
-    std::str::from_utf8(bytes).map_err(|e| {
-        let good = std::str::from_utf8(&bytes[..e.valid_up_to()]).unwrap_or("");
-        let line = good.matches('\n').count() + 1;
-        let col = good.rsplit('\n').next().map_or(0, |l| l.chars().count()) + 1;
+    std::str::from_utf8(bytes).map_err(|_| {
+        let (line, col, bad) = cov_core::utf8_error_at(bytes).unwrap_or((1, 1, 0));
         let utf16 = bytes.starts_with(&[0xFF, 0xFE]) || bytes.starts_with(&[0xFE, 0xFF]);
         PathError::Parse {
             file: name.to_string(),
@@ -181,10 +179,7 @@ fn utf8<'a>(bytes: &'a [u8], name: &str) -> Result<&'a str, PathError> {
             message: if utf16 {
                 "the file is UTF-16 text; path files are UTF-8".into()
             } else {
-                format!(
-                    "not UTF-8 text: byte 0x{:02X} cannot start or continue a character",
-                    bytes[e.valid_up_to()]
-                )
+                format!("not UTF-8 text: byte 0x{bad:02X} cannot start or continue a character")
             },
         }
     })

@@ -30,14 +30,6 @@ pub struct Entry {
     pub(crate) defaults: DefaultsFn,
 }
 
-impl Entry {
-    /// Whether every parameter has a default, so the operator may be written bare
-    /// (`Mirror`) as well as with parentheses (`Mirror()`).
-    pub fn all_defaults(&self) -> bool {
-        self.params.iter().all(|p| p.default.is_some())
-    }
-}
-
 impl fmt::Debug for Entry {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         write!(f, "Entry({})", self.name)

@@ -12,10 +12,9 @@
 //! 2. travel to the hit, with a `BlockerEdge` where auxiliary shadow rays to other points
 //!    of the light are blocked (the distance from the path to the nearest blocker hit, at
 //!    the blocker's depth);
-//! 3. the reflection at the hit ([`SurfaceBounce`]: projection, curvature of the shape,
-//!    mirror symmetry, the material's lobe, the turn from the plane of incidence to the
-//!    plane of the outgoing ray, inverse curvature, inverse projection), inside `Moving`
-//!    when the shape moves;
+//! 3. the reflection at the hit (cov-brdf's `Reflect::with_turn`: the shape's curvature,
+//!    the material's lobe, and the turn from the plane of incidence to the plane of the
+//!    outgoing ray), inside `Moving` when the shape moves;
 //! 4. travel to the camera, with a `Moving` `BlockerEdge` where auxiliary camera rays
 //!    around the pixel see a silhouette (a nearer surface or the background) in front of
 //!    or behind the hit: defocus and motion blur of edges;
@@ -25,13 +24,13 @@
 //! The pass holds Σ in covariance form: chains are short (at most about 15 operators), where
 //! both forms agree to rounding.
 
-use cov_brdf::Lobe;
-use cov_core::{AnyCov, Chain, CovError, Form, Operator, Spectrum};
+use cov_brdf::Reflect;
+use cov_core::{AnyCov, Chain, CovError, Form};
 use cov_curvature::Curvature;
 use cov_defocus::{Pinhole, ThinLens};
 use cov_motion::{CameraMotion, Moving, Shutter, ShutterShape};
 use cov_occlusion::BlockerEdge;
-use cov_projection::{Mirror, Project, RotateFrame, Unproject};
+use cov_projection::{RotateFrame, Unproject};
 use cov_sensor::{PixelDecisions, Sensor, SensorParams};
 use cov_travel::Travel;
 use glam::DVec3;
@@ -45,39 +44,6 @@ use crate::world::World;
 pub const SHADOW_PROBES: usize = 4;
 /// Auxiliary camera rays per covariance path (to find silhouettes near the pixel).
 pub const EDGE_PROBES: usize = 4;
-
-/// Reflection at a surface point for any pair of incident and outgoing directions: the
-/// cov-brdf composite's steps, with the turn between the two planes of incidence.
-#[derive(Clone, Copy, Debug)]
-pub struct SurfaceBounce {
-    /// Projection of the incident ray (frame x in its plane of incidence).
-    pub project: Project,
-    /// The shape's curvature.
-    pub curvature: Curvature,
-    /// The material's lobe.
-    pub lobe: Lobe,
-    /// Angle from the incident to the outgoing plane of incidence, about the normal.
-    pub turn: f64,
-    /// Inverse projection to the outgoing ray (frame x in its plane of incidence).
-    pub unproject: Unproject,
-}
-
-impl Operator for SurfaceBounce {
-    fn apply(&self, cov: &mut dyn Spectrum) -> Result<(), CovError> {
-        self.project.apply(cov)?;
-        // Incident directions in the surface frame point back toward the light.
-        Mirror.apply(cov)?;
-        self.curvature.apply_oblique(cov, self.project.cos(), 1.0)?;
-        Mirror.apply(cov)?;
-        self.lobe.apply_to(cov)?;
-        RotateFrame::new(self.turn)?.apply(cov)?;
-        self.curvature.apply_oblique(cov, self.unproject.cos(), -1.0)?;
-        self.unproject.apply(cov)
-    }
-    fn requires(&self) -> cov_core::AxisSet {
-        cov_core::AxisSet::SPACE
-    }
-}
 
 /// A unit vector orthogonal to `d`, in the plane of `d` and `n` when they are not parallel:
 /// the frame `x` of a ray in its plane of incidence.
@@ -242,13 +208,13 @@ pub fn trace_path<R: Rng>(
             let t_in = (x_in - hit.n * x_in.dot(hit.n)).normalize_or_zero();
             let t_out = (x_out - hit.n * x_out.dot(hit.n)).normalize_or_zero();
             let y_in = d_in.cross(x_in);
-            let bounce = SurfaceBounce {
-                project: Project::new(cos_i.clamp(1e-6, 1.0))?,
-                curvature: Curvature::isotropic(hit.curvature)?,
-                lobe: mat.lobe(),
-                turn: t_out.dot(y_in).atan2(t_out.dot(t_in)),
-                unproject: Unproject::new(hit.n.dot(d_out).clamp(1e-6, 1.0))?,
-            };
+            let bounce = Reflect::with_turn(
+                cos_i.clamp(1e-6, 1.0),
+                hit.n.dot(d_out).clamp(1e-6, 1.0),
+                Curvature::isotropic(hit.curvature)?,
+                mat.lobe(),
+                t_out.dot(y_in).atan2(t_out.dot(t_in)),
+            )?;
             if motion && hit.velocity != DVec3::ZERO {
                 chain.push(Moving::new(
                     in_frame(hit.velocity, d_out, x_out),
@@ -293,8 +259,8 @@ pub fn trace_path<R: Rng>(
             [0.0, 0.0],
         )?);
     }
-    let at_lens = chain.eval_any(Form::Covariance, &start)?;
-    let at_sensor = cc.end.eval_any(Form::Covariance, &at_lens)?;
+    chain.push(cc.end.clone());
+    let at_sensor = chain.eval_any(Form::Covariance, &start)?;
     let d = cc.sensor.decisions(at_sensor)?;
     if !(weight.is_finite() && weight >= 0.0) {
         return Ok(None);

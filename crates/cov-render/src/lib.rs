@@ -37,15 +37,4 @@ pub use render::{CovMaps, Image, MAX_COV_PATHS, MAX_SPP, covariance_maps, render
 pub use scene::SceneError;
 pub use world::World;
 
-/// Longest piece of user input echoed in a message (characters).
-pub const ECHO_MAX: usize = 64;
-
-/// `s`, cut to [`ECHO_MAX`] characters with `…` when longer.
-pub fn echo(s: &str) -> String {
-    if s.chars().count() <= ECHO_MAX {
-        s.to_string()
-    } else {
-        let cut: String = s.chars().take(ECHO_MAX).collect();
-        format!("{cut}… ({} characters)", s.chars().count())
-    }
-}
+pub use cov_core::echo;

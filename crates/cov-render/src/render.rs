@@ -61,6 +61,24 @@ fn tiles(width: u32, height: u32) -> Vec<(u32, u32, u32, u32)> {
     out
 }
 
+/// The image of per-tile results, each tile's values row by row, in tile order.
+fn assemble<T: Clone>(
+    w: u32,
+    h: u32,
+    tiles: &[(u32, u32, u32, u32)],
+    results: Vec<Vec<T>>,
+    fill: T,
+) -> Vec<T> {
+    let mut out = vec![fill; w as usize * h as usize];
+    for (&(x0, y0, x1, y1), tile) in tiles.iter().zip(results) {
+        let coords = (y0..y1).flat_map(|y| (x0..x1).map(move |x| (y * w + x) as usize));
+        for (i, v) in coords.zip(tile) {
+            out[i] = v;
+        }
+    }
+    out
+}
+
 /// The generator of tile `index` for `stream` (0: image samples, 1: covariance paths).
 fn tile_rng(seed: u64, stream: u64, index: usize) -> ChaCha8Rng {
     let mut rng = ChaCha8Rng::seed_from_u64(seed ^ (stream << 56));
@@ -163,21 +181,17 @@ pub fn render_clamped(
             out
         })
         .collect();
-    let mut img = Image::new(w, h);
-    let mut var = vec![0.0; img.pixels.len()];
-    for (&(x0, y0, x1, y1), tile) in tl.iter().zip(results) {
-        let mut it = tile.into_iter();
-        for y in y0..y1 {
-            for x in x0..x1 {
-                if let Some((c, v)) = it.next() {
-                    let i = (y * w + x) as usize;
-                    img.pixels[i] = c;
-                    var[i] = v;
-                }
-            }
-        }
-    }
-    (img, var)
+    let (pixels, var) = assemble(w, h, &tl, results, (DVec3::ZERO, 0.0))
+        .into_iter()
+        .unzip();
+    (
+        Image {
+            width: w,
+            height: h,
+            pixels,
+        },
+        var,
+    )
 }
 
 /// The covariance maps of an image: per pixel, the predicted image-space Σ and samples
@@ -267,34 +281,13 @@ pub fn covariance_maps_with(
             Ok(out)
         })
         .collect();
-    let results = results?;
-    let mut pixels = vec![PixelCov::default(); w as usize * h as usize];
-    for (&(x0, y0, x1, y1), tile) in tl.iter().zip(results) {
-        let mut it = tile.into_iter();
-        for y in y0..y1 {
-            for x in x0..x1 {
-                if let Some(p) = it.next() {
-                    pixels[(y * w + x) as usize] = p;
-                }
-            }
-        }
-    }
     Ok(CovMaps {
         width: w,
         height: h,
-        pixels,
+        pixels: assemble(w, h, &tl, results?, PixelCov::default()),
         paths_per_pixel: paths,
         layout: cc.layout(),
     })
-}
-
-/// Timing of a render, in seconds.
-#[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize)]
-pub struct Timing {
-    /// The covariance pass.
-    pub covariance: f64,
-    /// Path tracing.
-    pub sampling: f64,
 }
 
 /// Runs `f`, returning its result and the seconds it took.
@@ -412,21 +405,23 @@ pub fn write_maps(
 /// filters are made from this: the sensor's Σ would never allow a filter wider than the
 /// pixel filter itself.
 pub fn content(s: [f64; 3], pixel_filter: f64) -> [f64; 3] {
-    let w = 1.0 / (4.0 * std::f64::consts::PI.powi(2) * pixel_filter * pixel_filter);
+    let w = 1.0 / (cov_core::FOUR_PI_SQ * pixel_filter * pixel_filter);
     let (a, b, c) = ((s[0] - w).max(0.0), s[1], (s[2] - w).max(0.0));
     let lim = (a * c).sqrt();
     [a, b.clamp(-lim, lim), c]
 }
 
-/// The reconstruction filter's larger std (px) for an image-space Σ `[xx, xy, yy]`:
-/// the Gaussian whose spectrum matches (`std = 1/(2π √λ)` along each principal axis of Σ),
-/// clamped to `max_filter` where Σ is small or singular.
+/// The reconstruction filter's larger std (px) for an image-space Σ `[xx, xy, yy]`: the
+/// sensor's rule (`CovBlock::reconstruction_filter`: the Gaussian whose spectrum matches,
+/// clamped at `max_filter` where Σ is small or singular).
 pub fn filter_std(s: [f64; 3], max_filter: f64) -> f64 {
-    let (a, b, c) = (s[0], s[1], s[2]);
-    // Smaller eigenvalue without squaring the entries (no overflow for huge Σ).
-    let lmin = (0.5 * (a + c) - (0.5 * (a - c)).hypot(b)).max(0.0);
-    if lmin <= 0.0 {
-        return max_filter;
-    }
-    (1.0 / (2.0 * std::f64::consts::PI * lmin.sqrt())).min(max_filter)
+    let mut c = cov_core::Cov::<2>::zeros();
+    c.set(0, 0, s[0]);
+    c.set(0, 1, s[1]);
+    c.set(1, 1, s[2]);
+    c.block()
+        .reconstruction_filter(&[max_filter; 2])
+        .map_or(max_filter, |f| {
+            f.extents.iter().fold(0.0, |m: f64, v| m.max(*v)).min(max_filter)
+        })
 }

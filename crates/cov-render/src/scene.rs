@@ -34,7 +34,6 @@
 //! | `shapes` | | `Sphere(center, radius, material, velocity)`, `Quad(corner, edge_u, edge_v, material, velocity)`, `Mesh(obj, material, translate, scale, velocity)` |
 
 use std::collections::BTreeMap;
-use std::fmt;
 
 use serde::Deserialize;
 use serde::de::{Deserializer, Error as _};
@@ -310,11 +309,7 @@ pub enum ShapeDesc {
 
 /// Line and column (1-based) of the first occurrence of `needle` in `text`.
 pub(crate) fn position_of(text: &str, needle: &str) -> Option<(usize, usize)> {
-    let at = text.find(needle)?;
-    let before = &text[..at];
-    let line = before.matches('\n').count() + 1;
-    let col = before.rsplit('\n').next().map_or(0, |l| l.chars().count()) + 1;
-    Some((line, col))
+    Some(cov_core::line_col(&text[..text.find(needle)?]))
 }
 
 impl SceneFile {
@@ -332,15 +327,5 @@ impl SceneFile {
                 at: Some((e.span.start.line, e.span.start.col)),
                 message: e.code.to_string(),
             })
-    }
-}
-
-impl fmt::Display for MaterialDesc {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        match self {
-            MaterialDesc::Diffuse { .. } => f.write_str("Diffuse"),
-            MaterialDesc::Phong { .. } => f.write_str("Phong"),
-            MaterialDesc::Ggx { .. } => f.write_str("Ggx"),
-        }
     }
 }

@@ -99,7 +99,7 @@ pub fn radiance<R: Rng>(world: &World, ray: &CameraRay, rng: &mut R) -> DVec3 {
             let le = emitted(world, &h2);
             if le != DVec3::ZERO {
                 let light = &world.lights[li as usize];
-                let pl = light.pdf(hit.p, wi, h2.t, h2.n) / world.lights.len() as f64;
+                let pl = light.pdf(hit.p, wi, h2.t) / world.lights.len() as f64;
                 l += throughput * le * (pb * pb / (pb * pb + pl * pl));
             }
         }

@@ -243,15 +243,14 @@ impl Light {
     }
 
     /// Density in solid angle with which [`Light::sample`] picks `wi` from `x`, given that
-    /// the ray hits the light at distance `dist` where its normal is `n_hit`.
-    pub fn pdf(&self, x: DVec3, wi: DVec3, dist: f64, n_hit: DVec3) -> f64 {
+    /// the ray hits the light at distance `dist`.
+    pub fn pdf(&self, x: DVec3, wi: DVec3, dist: f64) -> f64 {
         match *self {
             Light::Rect { n, area, .. } => {
                 let cos_l = -wi.dot(n);
                 if cos_l <= 0.0 {
                     return 0.0;
                 }
-                let _ = n_hit;
                 dist * dist / (cos_l * area)
             }
             Light::Sphere { center, radius, .. } => {
@@ -320,10 +319,7 @@ impl World {
         }
         let bytes = std::fs::read(path).map_err(|e| err(e.to_string()))?;
         let text = String::from_utf8(bytes).map_err(|e| {
-            let good = &e.as_bytes()[..e.utf8_error().valid_up_to()];
-            let text = String::from_utf8_lossy(good);
-            let line = text.matches('\n').count() + 1;
-            let col = text.rsplit('\n').next().map_or(0, |l| l.chars().count()) + 1;
+            let (line, col) = cov_core::utf8_error_at(e.as_bytes()).map_or((1, 1), |(l, c, _)| (l, c));
             SceneError {
                 file: file.clone(),
                 at: Some((line, col)),
