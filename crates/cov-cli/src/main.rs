@@ -58,6 +58,10 @@ enum Command {
     /// Render a scene (RON) with uniform sampling; also writes the covariance pass's
     /// density and filter maps.
     Render(cov_cli::render::RenderArgs),
+    /// Image error against run time: every sampling and reconstruction method (uniform,
+    /// Gaussian, variance-driven, covariance-driven) at several budgets against a cached
+    /// reference; writes CSV/JSON, the error-time chart and an equal-time strip.
+    RenderBench(cov_cli::bench::BenchArgs),
     /// The stiff suite: extreme chains in both forms and plain f64 against a
     /// double-double reference.
     Stiff {
@@ -199,6 +203,7 @@ fn run(cli: Cli) -> Result<(), String> {
             say!("{}", cov_stiff::report(&outcomes).trim_end());
         }
         Command::Render(args) => say!("{}", cov_cli::render::run(&args)?.trim_end()),
+        Command::RenderBench(args) => say!("{}", cov_cli::bench::bench(&args)?.trim_end()),
         Command::RenderCheck(args) => say!("{}", cov_cli::render::check(&args)?.trim_end()),
         Command::List => {
             for e in registry.entries() {

@@ -37,6 +37,55 @@ pub fn register_font() -> Result<(), String> {
     .clone()
 }
 
+/// A picture that draws itself on any plotters backend, saved by [`save`].
+pub trait Picture {
+    /// Draws on `root`.
+    ///
+    /// # Errors
+    /// What the backend reports.
+    fn draw<DB: DrawingBackend>(&self, root: DrawingArea<DB, Shift>) -> Result<(), Box<dyn std::error::Error>>
+    where
+        DB::ErrorType: 'static;
+}
+
+/// Saves `pic` at `size` px as SVG (`.svg`) or PNG (any other extension), with the
+/// embedded font.
+///
+/// # Errors
+/// The file cannot be written.
+pub fn save<P: Picture>(path: &std::path::Path, size: (u32, u32), pic: &P) -> Result<(), Box<dyn std::error::Error>> {
+    register_font()?;
+    let (w, h) = size;
+    if path.extension().is_some_and(|e| e == "svg") {
+        pic.draw(SVGBackend::new(path, (w, h)).into_drawing_area())
+    } else {
+        let mut buf = vec![0u8; (w as usize) * (h as usize) * 3];
+        pic.draw(BitMapBackend::with_buffer(&mut buf, (w, h)).into_drawing_area())?;
+        image::RgbImage::from_raw(w, h, buf)
+            .ok_or("image buffer size")?
+            .save(path)?;
+        Ok(())
+    }
+}
+
+/// Colours distinct on white and in greyscale (decreasing luminance), with a marker each.
+pub const COLORS: [RGBColor; 8] = [
+    RGBColor(0, 0, 0),
+    RGBColor(213, 94, 0),
+    RGBColor(0, 114, 178),
+    RGBColor(0, 158, 115),
+    RGBColor(204, 121, 167),
+    RGBColor(86, 86, 86),
+    RGBColor(230, 159, 0),
+    RGBColor(120, 28, 129),
+];
+
+/// Tick labels of a log axis: `1e-7`, `3e2`.
+pub fn log_tick(v: &f64) -> String {
+    let s = format!("{v:.0e}");
+    s.replace("e0", "").replace('+', "")
+}
+
 /// One plane of the spectrum: its row/column pair, colour, style and name.
 struct Plane {
     axes: (usize, usize),

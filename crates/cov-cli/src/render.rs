@@ -87,7 +87,8 @@ pub fn check_output(out: &Path, ext: &str) -> Result<(), String> {
     Ok(())
 }
 
-fn bar(len: usize, what: &str) -> ProgressBar {
+/// A progress bar over `len` tiles labelled `what`.
+pub fn bar(len: usize, what: &str) -> ProgressBar {
     let b = ProgressBar::new(len as u64);
     b.set_style(
         ProgressStyle::with_template("{msg:12} {bar:40} {pos}/{len} tiles [{elapsed}]")

@@ -15,6 +15,8 @@ use covtrace::travel::Travel;
 use covtrace::{Chain, Cov};
 use plotters::prelude::*;
 
+use crate::plot::{COLORS, log_tick};
+
 /// One bundled chain: its operators and its primal field built from PHYSICS.md.
 pub struct Case {
     /// Name in the table.
@@ -215,26 +217,19 @@ pub fn chart(path: &str, rows: &[Row]) -> Result<(), Box<dyn std::error::Error>>
 /// (case, gaussian, predict µs, (measure ms, error) per grid).
 type Series = (&'static str, bool, f64, Vec<(f64, f64)>);
 
-/// Colours distinct on white and in greyscale (decreasing luminance), with a marker each.
-const COLORS: [RGBColor; 8] = [
-    RGBColor(0, 0, 0),
-    RGBColor(213, 94, 0),
-    RGBColor(0, 114, 178),
-    RGBColor(0, 158, 115),
-    RGBColor(204, 121, 167),
-    RGBColor(86, 86, 86),
-    RGBColor(230, 159, 0),
-    RGBColor(120, 28, 129),
-];
-
-/// Tick labels of a log axis: `1e-7`, `3e2`.
-fn log_tick(v: &f64) -> String {
-    let s = format!("{v:.0e}");
-    s.replace("e0", "").replace('+', "")
-}
-
 /// Draws the chart on any plotters backend: the chart on the left, the legend in its own
 /// column on the right (it covers no data).
+struct ValidateChart<'a>(&'a [Series]);
+
+impl crate::plot::Picture for ValidateChart<'_> {
+    fn draw<DB: DrawingBackend>(&self, root: DrawingArea<DB, plotters::coord::Shift>) -> Result<(), Box<dyn std::error::Error>>
+    where
+        DB::ErrorType: 'static,
+    {
+        draw_on(root, self.0)
+    }
+}
+
 fn draw_on<DB: DrawingBackend>(
     root: DrawingArea<DB, plotters::coord::Shift>,
     series: &[Series],
@@ -315,19 +310,5 @@ where
 
 /// Writes the chart as SVG (`.svg`) or PNG (any other extension), with the embedded font.
 fn draw(path: &str, series: &[Series]) -> Result<(), Box<dyn std::error::Error>> {
-    crate::plot::register_font()?;
-    let (w, h) = (1180u32, 560u32);
-    if path.ends_with(".svg") {
-        draw_on(SVGBackend::new(path, (w, h)).into_drawing_area(), series)
-    } else {
-        let mut buf = vec![0u8; (w * h * 3) as usize];
-        draw_on(
-            BitMapBackend::with_buffer(&mut buf, (w, h)).into_drawing_area(),
-            series,
-        )?;
-        image::RgbImage::from_raw(w, h, buf)
-            .ok_or("image buffer size")?
-            .save(path)?;
-        Ok(())
-    }
+    crate::plot::save(std::path::Path::new(path), (1180, 560), &ValidateChart(series))
 }

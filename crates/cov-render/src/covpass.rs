@@ -19,7 +19,7 @@
 //!    around the pixel see a silhouette (a nearer surface or the background) in front of
 //!    or behind the hit: defocus and motion blur of edges;
 //! 5. the camera: its motion, the shutter window, the thin lens (or pinhole), and the
-//!    sensor's decisions (`Sensor::decisions`).
+//!    sensor's sampling rates (`Sensor::rates`).
 //!
 //! The pass holds Σ in covariance form: chains are short (at most about 15 operators), where
 //! both forms agree to rounding.
@@ -31,7 +31,7 @@ use cov_defocus::{Pinhole, ThinLens};
 use cov_motion::{CameraMotion, Moving, Shutter, ShutterShape};
 use cov_occlusion::BlockerEdge;
 use cov_projection::{RotateFrame, Unproject};
-use cov_sensor::{PixelDecisions, Sensor, SensorParams};
+use cov_sensor::{PixelRates, Sensor, SensorParams};
 use cov_travel::Travel;
 use glam::DVec3;
 use rand::Rng;
@@ -146,7 +146,7 @@ fn source(layout: usize, s: f64) -> Result<AnyCov, CovError> {
 }
 
 /// Traces one covariance path through the pixel point `(px, py)` at time uniform `ut`;
-/// returns the decisions and the path's weight, or `None` when the path sees nothing.
+/// returns the sensor's rates and the path's weight, or `None` when the path sees nothing.
 pub fn trace_path<R: Rng>(
     world: &World,
     cc: &CovCamera,
@@ -154,7 +154,7 @@ pub fn trace_path<R: Rng>(
     py: f64,
     ut: f64,
     rng: &mut R,
-) -> Result<Option<(PixelDecisions, f64)>, CovError> {
+) -> Result<Option<(PixelRates, f64)>, CovError> {
     let cam = &world.camera;
     let ray = cam.ray(px, py, (0.5, 0.5), ut);
     let time = ray.time;
@@ -261,7 +261,7 @@ pub fn trace_path<R: Rng>(
     }
     chain.push(cc.end.clone());
     let at_sensor = chain.eval_any(Form::Covariance, &start)?;
-    let d = cc.sensor.decisions(at_sensor)?;
+    let d = cc.sensor.rates(&at_sensor)?;
     if !(weight.is_finite() && weight >= 0.0) {
         return Ok(None);
     }

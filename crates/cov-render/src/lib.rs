@@ -24,10 +24,13 @@
 
 #![warn(missing_docs)]
 
+pub mod bench;
 pub mod covpass;
+pub mod film;
 pub mod geometry;
 pub mod material;
 pub mod render;
+pub mod sampler;
 pub mod scene;
 pub mod trace;
 pub mod validate;

@@ -13,7 +13,7 @@ use rand_chacha::ChaCha8Rng;
 use rayon::prelude::*;
 
 use crate::covpass::{CovCamera, PixelCov, trace_path};
-use crate::trace::radiance;
+use crate::film::Film;
 use crate::world::World;
 
 /// Tile side (px).
@@ -51,7 +51,7 @@ impl Image {
 }
 
 /// The tiles of a `width × height` image: (x0, y0, x1, y1).
-fn tiles(width: u32, height: u32) -> Vec<(u32, u32, u32, u32)> {
+pub(crate) fn tiles(width: u32, height: u32) -> Vec<(u32, u32, u32, u32)> {
     let mut out = Vec::new();
     for y0 in (0..height).step_by(TILE as usize) {
         for x0 in (0..width).step_by(TILE as usize) {
@@ -86,8 +86,8 @@ fn tile_rng(seed: u64, stream: u64, index: usize) -> ChaCha8Rng {
     rng
 }
 
-/// Renders `spp` samples per pixel with a box pixel filter, stratified over the pixel on a
-/// √spp grid (jittered), uniform over lens and shutter.
+/// Renders `spp` samples per pixel with a box pixel filter, over pixel × lens × time from
+/// each pixel's Owen-scrambled Sobol sequence ([`crate::sampler`]).
 pub fn render(world: &World, spp: u32, seed: u64) -> Image {
     let spp = spp.clamp(1, MAX_SPP);
     let per_pixel = vec![spp; world.camera.width as usize * world.camera.height as usize];
@@ -97,13 +97,14 @@ pub fn render(world: &World, spp: u32, seed: u64) -> Image {
 /// Called once per finished tile (to drive a progress bar).
 pub type Progress<'a> = Option<&'a (dyn Fn() + Sync)>;
 
-/// Number of tiles of the world's image (what [`Progress`] counts to).
+/// Number of tiles of the world's image (what [`Progress`] counts to, once per pass).
 pub fn tile_count(world: &World) -> usize {
     tiles(world.camera.width, world.camera.height).len()
 }
 
-/// Renders `counts[i]` samples in pixel `i` (at least 1, at most [`MAX_SPP`] each); also
-/// returns the per-pixel sample variance of the luminance (for variance-driven sampling).
+/// Renders `counts[i]` samples in pixel `i` (at least 1, at most [`MAX_SPP`] each) with a
+/// box pixel filter; also returns the per-pixel sample variance of the luminance (for
+/// variance-driven sampling).
 pub fn render_adaptive(
     world: &World,
     counts: &[u32],
@@ -124,74 +125,12 @@ pub fn render_clamped(
     progress: Progress<'_>,
 ) -> (Image, Vec<f64>) {
     let (w, h) = (world.camera.width, world.camera.height);
-    let tl = tiles(w, h);
-    let results: Vec<Vec<(DVec3, f64)>> = tl
-        .par_iter()
-        .enumerate()
-        .map(|(index, &(x0, y0, x1, y1))| {
-            let mut rng = tile_rng(seed, 0, index);
-            let mut out = Vec::with_capacity(((x1 - x0) * (y1 - y0)) as usize);
-            for y in y0..y1 {
-                for x in x0..x1 {
-                    let n = counts[(y * w + x) as usize].clamp(1, MAX_SPP);
-                    let side = (n as f64).sqrt().floor().max(1.0) as u32;
-                    let strata = side * side;
-                    let (mut sum, mut sum_l, mut sum_l2) = (DVec3::ZERO, 0.0, 0.0);
-                    for s in 0..n {
-                        let (jx, jy) = if s < strata {
-                            (
-                                ((s % side) as f64 + rng.random::<f64>()) / side as f64,
-                                ((s / side) as f64 + rng.random::<f64>()) / side as f64,
-                            )
-                        } else {
-                            (rng.random(), rng.random())
-                        };
-                        let ray = world.camera.ray(
-                            x as f64 + jx,
-                            y as f64 + jy,
-                            (rng.random(), rng.random()),
-                            rng.random(),
-                        );
-                        let l = radiance(world, &ray, &mut rng);
-                        let l = if l.is_finite() { l } else { DVec3::ZERO };
-                        let y_l = crate::trace::luminance(l);
-                        let l = if y_l > max_luminance {
-                            l * (max_luminance / y_l)
-                        } else {
-                            l
-                        };
-                        sum += l;
-                        let y_l = crate::trace::luminance(l);
-                        sum_l += y_l;
-                        sum_l2 += y_l * y_l;
-                    }
-                    let nf = n as f64;
-                    let mean_l = sum_l / nf;
-                    let var = if n > 1 {
-                        ((sum_l2 - nf * mean_l * mean_l) / (nf - 1.0)).max(0.0)
-                    } else {
-                        0.0
-                    };
-                    out.push((sum / nf, var));
-                }
-            }
-            if let Some(p) = progress {
-                p();
-            }
-            out
-        })
+    let counts: Vec<u32> = (0..w as usize * h as usize)
+        .map(|i| counts.get(i).copied().unwrap_or(1).clamp(1, MAX_SPP))
         .collect();
-    let (pixels, var) = assemble(w, h, &tl, results, (DVec3::ZERO, 0.0))
-        .into_iter()
-        .unzip();
-    (
-        Image {
-            width: w,
-            height: h,
-            pixels,
-        },
-        var,
-    )
+    let mut film = Film::new(w, h);
+    film.render(world, &counts, seed, max_luminance, progress);
+    (film.box_image(), film.variance())
 }
 
 /// The covariance maps of an image: per pixel, the predicted image-space Σ and samples
@@ -308,6 +247,17 @@ fn srgb(c: f64) -> u8 {
     (s * 255.0 + 0.5) as u8
 }
 
+/// The tone-mapped sRGB picture of `img` (Reinhard on luminance, which keeps hues;
+/// exposure 1).
+pub fn tonemap(img: &Image) -> image::RgbImage {
+    image::RgbImage::from_fn(img.width, img.height, |x, y| {
+        let p = img.get(x, y);
+        let l = crate::trace::luminance(p).max(0.0);
+        let s = if l > 0.0 { 1.0 / (1.0 + l) } else { 1.0 };
+        image::Rgb([srgb(p.x * s), srgb(p.y * s), srgb(p.z * s)])
+    })
+}
+
 /// Writes `img` as linear OpenEXR (`.exr`) and a tone-mapped sRGB PNG beside it.
 ///
 /// # Errors
@@ -320,18 +270,29 @@ pub fn write_image(img: &Image, exr: &Path, png: &Path) -> Result<(), String> {
         .collect();
     let hdr = image::Rgb32FImage::from_raw(img.width, img.height, raw).ok_or("image size")?;
     hdr.save(exr).map_err(|e| format!("{}: {e}", exr.display()))?;
-    let ldr = image::RgbImage::from_fn(img.width, img.height, |x, y| {
-        let p = img.get(x, y);
-        // Reinhard on luminance keeps hues; exposure 1.
-        let l = crate::trace::luminance(p).max(0.0);
-        let s = if l > 0.0 { 1.0 / (1.0 + l) } else { 1.0 };
-        image::Rgb([srgb(p.x * s), srgb(p.y * s), srgb(p.z * s)])
-    });
-    ldr.save(png).map_err(|e| format!("{}: {e}", png.display()))
+    tonemap(img).save(png).map_err(|e| format!("{}: {e}", png.display()))
+}
+
+/// Reads a linear RGB image (an EXR written by [`write_image`]).
+///
+/// # Errors
+/// The file cannot be read or decoded.
+pub fn read_image(path: &Path) -> Result<Image, String> {
+    let img = image::open(path)
+        .map_err(|e| format!("{}: {e}", path.display()))?
+        .into_rgb32f();
+    Ok(Image {
+        width: img.width(),
+        height: img.height(),
+        pixels: img
+            .pixels()
+            .map(|p| DVec3::new(f64::from(p[0]), f64::from(p[1]), f64::from(p[2])))
+            .collect(),
+    })
 }
 
 /// A perceptually ordered colour map (dark blue → yellow) for `t` in `[0, 1]`.
-fn colormap(t: f64) -> [u8; 3] {
+pub fn colormap(t: f64) -> [u8; 3] {
     let t = if t.is_finite() { t.clamp(0.0, 1.0) } else { 0.0 };
     // A few stops of viridis.
     const STOPS: [[f64; 3]; 5] = [

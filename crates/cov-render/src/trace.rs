@@ -6,7 +6,7 @@
 //! (camera → x₁ → light, camera → x₁ → x₂ → light) and lights seen directly.
 
 use glam::DVec3;
-use rand::Rng;
+use crate::sampler::Sampler;
 
 use crate::geometry::Hit;
 use crate::world::{CameraRay, World};
@@ -35,11 +35,18 @@ fn emitted(world: &World, hit: &Hit) -> DVec3 {
 }
 
 /// Light sampling at a surface hit; with `mis`, weighted against BRDF sampling.
-fn direct<R: Rng>(world: &World, hit: &Hit, wo: DVec3, time: f64, rng: &mut R, mis: bool) -> DVec3 {
+fn direct<S: Sampler + ?Sized>(
+    world: &World,
+    hit: &Hit,
+    wo: DVec3,
+    time: f64,
+    rng: &mut S,
+    mis: bool,
+) -> DVec3 {
     let n_lights = world.lights.len();
-    let pick = (rng.random::<f64>() * n_lights as f64) as usize;
+    let pick = (rng.next() * n_lights as f64) as usize;
     let light = &world.lights[pick.min(n_lights - 1)];
-    let Some(ls) = light.sample(hit.p, rng.random(), rng.random()) else {
+    let Some(ls) = light.sample(hit.p, rng.next(), rng.next()) else {
         return DVec3::ZERO;
     };
     let mat = &world.materials[hit.material as usize];
@@ -66,21 +73,36 @@ fn direct<R: Rng>(world: &World, hit: &Hit, wo: DVec3, time: f64, rng: &mut R, m
 }
 
 /// The radiance arriving along a camera ray (one sample of the estimator).
-pub fn radiance<R: Rng>(world: &World, ray: &CameraRay, rng: &mut R) -> DVec3 {
+pub fn radiance<S: Sampler + ?Sized>(world: &World, ray: &CameraRay, rng: &mut S) -> DVec3 {
+    let (e, r) = radiance_parts(world, ray, rng);
+    e + r
+}
+
+/// [`radiance`] in two parts: the emission of a light the ray sees directly, and the
+/// light reflected by the surface it sees. A film reconstructs only the second with a
+/// filter: an emitter's own edge is as sharp as the pixel grid, and its radiance is far
+/// above what it borders.
+pub fn radiance_parts<S: Sampler + ?Sized>(world: &World, ray: &CameraRay, rng: &mut S) -> (DVec3, DVec3) {
     let Some(hit) = world
         .geometry
         .intersect(ray.origin, ray.dir, ray.time, 0.0, f64::INFINITY)
     else {
-        return DVec3::ZERO;
+        return (DVec3::ZERO, DVec3::ZERO);
     };
     if hit.light.is_some() {
-        return emitted(world, &hit);
+        return (emitted(world, &hit), DVec3::ZERO);
     }
+    (DVec3::ZERO, reflected(world, ray, &hit, rng))
+}
+
+/// The light the surface at `hit` reflects towards the camera.
+fn reflected<S: Sampler + ?Sized>(world: &World, ray: &CameraRay, hit: &Hit, rng: &mut S) -> DVec3 {
+    let hit = *hit;
     let wo = -ray.dir;
     let mut l = direct(world, &hit, wo, ray.time, rng, true);
     // One indirect bounce, by BRDF sampling.
     let mat = &world.materials[hit.material as usize];
-    let Some(wi) = mat.sample(hit.n, wo, rng.random(), rng.random()) else {
+    let Some(wi) = mat.sample(hit.n, wo, rng.next(), rng.next()) else {
         return l;
     };
     let pb = mat.pdf(hit.n, wo, wi);

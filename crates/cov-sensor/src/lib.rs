@@ -149,6 +149,24 @@ pub const MAX_FILTER_PX: f64 = 1e6;
 /// Largest aperture (m) or shutter (s) std a sensor accepts.
 pub const MAX_EXTENT: f64 = 1e6;
 
+/// Largest layout (`cov_core::linalg`'s matrix side).
+const MAX: usize = cov_core::linalg::MAX;
+
+/// The per-pixel sampling rates ([`Sensor::rates`]): what a renderer needs per path.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PixelRates {
+    /// Image axes (1 or 2).
+    pub image_dims: usize,
+    /// Image-space Σ in (cycles/px)² (the first `image_dims` rows and columns).
+    pub image_cov_px: [[f64; 2]; 2],
+    /// Axes of the sampled domain (image, lens, time).
+    pub sampled_dims: usize,
+    /// Samples per unit volume of the sampled domain (px^i · m^l · s^t).
+    pub density: f64,
+    /// Samples per pixel (density × lens area × shutter span).
+    pub samples_per_pixel: f64,
+}
+
 /// What a renderer needs per pixel (see the crate docs).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct PixelDecisions {
@@ -264,78 +282,133 @@ impl Sensor {
         Ok(())
     }
 
-    /// The per-pixel decisions from Σ arriving at the sensor (before the sensor operator).
+    /// The per-pixel sampling rates from Σ arriving at the sensor (before the sensor
+    /// operator): the image-space Σ and the sample density. What a renderer needs per
+    /// path, without the filter's eigen-directions or any allocation of names
+    /// ([`Sensor::decisions`] adds those).
     ///
     /// # Errors
-    /// Overflow, or an aperture/shutter given for a layout without `u`/`t`.
-    pub fn decisions(&self, at_sensor: impl Into<AnyCov>) -> Result<PixelDecisions, CovError> {
-        let mut c: AnyCov = at_sensor.into();
+    /// Overflow, or a shutter given for a layout without `t`.
+    pub fn rates(&self, at_sensor: &AnyCov) -> Result<PixelRates, CovError> {
+        let mut c: AnyCov = *at_sensor;
         self.pixel_filter(c.as_spectrum_mut())?;
-        let image_axes = c.as_spectrum_mut().spatial_axes();
-        let direction_axes = c.as_spectrum_mut().direction_axes();
+        let s = c.as_spectrum_mut();
+        let image_axes = s.spatial_axes();
+        let direction_axes = s.direction_axes();
         let n_img = image_axes.len();
         // Image-space Σ: integrate over everything but position, in pixel units.
         let img_px = scaled_block(&c, image_axes, self.pitch)?;
-        let image_cov_px: Vec<Vec<f64>> = (0..n_img)
-            .map(|i| (0..n_img).map(|j| img_px.get(i, j)).collect())
-            .collect();
-        let filter = img_px.reconstruction_filter(&vec![self.p.max_filter; n_img])?;
+        let mut image_cov_px = [[0.0; 2]; 2];
+        for (i, row) in image_cov_px.iter_mut().enumerate().take(n_img) {
+            for (j, v) in row.iter_mut().enumerate().take(n_img) {
+                *v = img_px.get(i, j);
+            }
+        }
         // Sampled domain: image, lens (with an aperture), time (with a shutter).
-        let mut keep: Vec<Axis> = image_axes.to_vec();
-        if self.p.aperture.is_some() {
-            keep.extend_from_slice(direction_axes);
-        }
-        if self.p.shutter.is_some() {
-            axis_index(c.dim(), Axis::T)?;
-            keep.push(Axis::T);
-        }
-        let block = c.integrated(&keep)?.to_dmatrix();
-        let k = keep.len();
-        // Change of variables (x_px, lens, t) → (x_s, u, t): x_s = pitch·x_px,
-        // u = (pitch·x_px − lens)/distance.
-        let mut a = nalgebra::DMatrix::<f64>::zeros(k, k);
-        for i in 0..n_img {
-            a[(i, i)] = self.pitch;
+        let mut keep = [Axis::X; 5];
+        let mut k = 0;
+        for &a in image_axes {
+            keep[k] = a;
+            k += 1;
         }
         if self.p.aperture.is_some() {
-            for i in 0..n_img {
-                a[(n_img + i, i)] = self.pitch / self.p.distance;
-                a[(n_img + i, n_img + i)] = -1.0 / self.p.distance;
+            for &a in direction_axes {
+                keep[k] = a;
+                k += 1;
             }
         }
         if self.p.shutter.is_some() {
-            a[(k - 1, k - 1)] = 1.0;
+            axis_index(c.dim(), Axis::T)?;
+            keep[k] = Axis::T;
+            k += 1;
         }
-        let sampled = a.transpose() * block * &a;
-        let det = sampled
-            .clone()
-            .symmetric_eigen()
-            .eigenvalues
-            .iter()
-            .map(|v| v.max(0.0))
-            .product::<f64>();
+        let block = c.integrated(&keep[..k])?;
+        // Change of variables (x_px, lens, t) → (x_s, u, t): x_s = pitch·x_px,
+        // u = (pitch·x_px − lens)/distance. A is sparse: column j of A has its entries on
+        // rows j and, for an image axis with a lens, n_img + j.
+        let mut a = [[0.0; 5]; 5];
+        for (i, row) in a.iter_mut().enumerate().take(n_img) {
+            row[i] = self.pitch;
+        }
+        if self.p.aperture.is_some() {
+            for i in 0..n_img {
+                a[n_img + i][i] = self.pitch / self.p.distance;
+                a[n_img + i][n_img + i] = -1.0 / self.p.distance;
+            }
+        }
+        if self.p.shutter.is_some() {
+            a[k - 1][k - 1] = 1.0;
+        }
+        // sampled = Aᵀ B A.
+        let mut ba = [[0.0; MAX]; MAX];
+        for i in 0..k {
+            for j in 0..k {
+                ba[i][j] = (0..k).map(|l| block.get(i, l) * a[l][j]).sum();
+            }
+        }
+        let mut sampled = [[0.0; MAX]; MAX];
+        for i in 0..k {
+            for j in 0..k {
+                sampled[i][j] = (0..k).map(|l| a[l][i] * ba[l][j]).sum();
+            }
+        }
+        let (vals, _) = cov_core::linalg::sym_eigen(k, &sampled);
+        let det: f64 = vals[..k].iter().map(|v| v.max(0.0)).product();
         let density = (2.0 * self.p.nyquist).powi(k as i32) * det.sqrt();
         let root2pi = (2.0 * PI).sqrt();
         let mut span = 1.0;
-        let mut sampled_axes: Vec<String> = image_axes.iter().map(|a| format!("{a}_px")).collect();
         if let Some(ap) = self.p.aperture {
             span *= (root2pi * ap).powi(n_img as i32);
-            sampled_axes.extend(image_axes.iter().map(|a| format!("lens_{a}")));
         }
         if let Some(sh) = self.p.shutter {
             span *= root2pi * sh;
-            sampled_axes.push("t".into());
         }
-        let n = filter.extents.len();
-        if !(density.is_finite()
-            && (density * span).is_finite()
-            && filter.extents.iter().all(|v| v.is_finite()))
-        {
+        if !(density.is_finite() && (density * span).is_finite()) {
             return Err(CovError::NoTransport {
                 operator: Self::NAME.into(),
                 reason: format!(
                     "the sampling density overflows f64 (density {density:e}, over a domain of {span:e}): Σ at the sensor is beyond what a renderer can sample"
                 ),
+            });
+        }
+        Ok(PixelRates {
+            image_dims: n_img,
+            image_cov_px,
+            sampled_dims: k,
+            density,
+            samples_per_pixel: density * span,
+        })
+    }
+
+    /// The per-pixel decisions from Σ arriving at the sensor (before the sensor operator):
+    /// [`Sensor::rates`] with the reconstruction filter and the axes named.
+    ///
+    /// # Errors
+    /// Overflow, or an aperture/shutter given for a layout without `u`/`t`.
+    pub fn decisions(&self, at_sensor: impl Into<AnyCov>) -> Result<PixelDecisions, CovError> {
+        let c: AnyCov = at_sensor.into();
+        let r = self.rates(&c)?;
+        let mut c2 = c;
+        self.pixel_filter(c2.as_spectrum_mut())?;
+        let image_axes = c2.as_spectrum_mut().spatial_axes();
+        let n_img = r.image_dims;
+        let image_cov_px: Vec<Vec<f64>> = (0..n_img)
+            .map(|i| r.image_cov_px[i][..n_img].to_vec())
+            .collect();
+        let filter = scaled_block(&c2, image_axes, self.pitch)?
+            .reconstruction_filter(&vec![self.p.max_filter; n_img])?;
+        let mut sampled_axes: Vec<String> = image_axes.iter().map(|a| format!("{a}_px")).collect();
+        if self.p.aperture.is_some() {
+            sampled_axes.extend(image_axes.iter().map(|a| format!("lens_{a}")));
+        }
+        if self.p.shutter.is_some() {
+            sampled_axes.push("t".into());
+        }
+        let n = filter.extents.len();
+        if !filter.extents.iter().all(|v| v.is_finite()) {
+            return Err(CovError::NoTransport {
+                operator: Self::NAME.into(),
+                reason: "the reconstruction filter overflows f64: Σ at the sensor is beyond what a renderer can sample".into(),
             });
         }
         Ok(PixelDecisions {
@@ -352,8 +425,8 @@ impl Sensor {
                 .collect(),
             filter_clamped: filter.clamped,
             sampled_axes,
-            density,
-            samples_per_pixel: density * span,
+            density: r.density,
+            samples_per_pixel: r.samples_per_pixel,
         })
     }
 

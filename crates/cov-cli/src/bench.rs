@@ -1,0 +1,499 @@
+//! `covtrace render-bench`: every sampling and reconstruction method
+//! ([`cov_render::bench::Method`]) at several sample budgets, against a cached
+//! high-spp reference; image error against wall-clock time, the equal-error speed-up over
+//! plain Monte Carlo, and the timing breakdown.
+//!
+//! Writes into the output folder: `results.csv`, `results.json`, `error_time.png` and
+//! `.svg` (relMSE against seconds, log–log), `strip.png` (each method at about equal
+//! time beside the reference) and `reference.png`. The reference is cached as
+//! `reference-<key>.exr`, keyed by the scene text, size, reference spp and seed.
+
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+
+use cov_render::bench::{Guide, Method, Run, error, fit_loglog, run, speedup};
+use cov_render::render::{covariance_maps_with, read_image, render_adaptive, tile_count, timed, tonemap, write_image};
+use cov_render::{MAX_COV_PATHS, MAX_SPP, World};
+use plotters::coord::Shift;
+use plotters::prelude::*;
+
+use crate::plot::{COLORS, Picture, log_tick};
+use crate::render::{bar, parse_size};
+
+/// Largest number of budgets one bench takes.
+pub const MAX_BUDGETS: usize = 12;
+
+/// What `covtrace render-bench` was asked (parsed by clap).
+#[derive(Clone, Debug, clap::Args)]
+pub struct BenchArgs {
+    /// The scene file.
+    pub scene: PathBuf,
+    /// Average samples per pixel of each run, comma-separated (1 to 65536 each).
+    #[arg(long, value_delimiter = ',', default_values_t = [2.0, 4.0, 8.0, 16.0, 32.0])]
+    pub budgets: Vec<f64>,
+    /// Methods, comma-separated (default: all): uniform, gauss, variance, cov-density,
+    /// cov-filter, cov.
+    #[arg(long, value_delimiter = ',')]
+    pub methods: Vec<String>,
+    /// Samples per pixel of the reference.
+    #[arg(long, default_value_t = 1024)]
+    pub ref_spp: u32,
+    /// Covariance paths per pixel.
+    #[arg(long, default_value_t = 2)]
+    pub cov_paths: u32,
+    /// Render at this size instead of the scene's (`WIDTHxHEIGHT`).
+    #[arg(long, value_parser = parse_size)]
+    pub size: Option<(u32, u32)>,
+    /// Seed of the runs (the reference uses another).
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
+    /// Output folder (created if missing; its parent must exist).
+    #[arg(short, long, default_value = "render-bench")]
+    pub output: PathBuf,
+    /// Folder of cached references (default: the output folder).
+    #[arg(long)]
+    pub cache: Option<PathBuf>,
+}
+
+/// One row of the results.
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct Row {
+    /// Method name.
+    pub method: &'static str,
+    /// Average samples per pixel asked for.
+    pub budget: f64,
+    /// Samples taken.
+    pub samples: u64,
+    /// Wall-clock seconds in all.
+    pub seconds: f64,
+    /// Of which the covariance pass.
+    pub covariance_s: f64,
+    /// Tracing samples.
+    pub sampling_s: f64,
+    /// Splatting through filters.
+    pub reconstruction_s: f64,
+    /// Allocating samples.
+    pub allocation_s: f64,
+    /// Root mean square error against the reference.
+    pub rmse: f64,
+    /// Relative mean square error against the reference.
+    pub relmse: f64,
+    /// Equal-error speed-up over uniform Monte Carlo (`null` when undefined).
+    pub speedup: Option<f64>,
+}
+
+impl Row {
+    fn new(r: &Run, reference: &cov_render::Image) -> Result<Row, String> {
+        let e = error(&r.image, reference)?;
+        Ok(Row {
+            method: r.method.name(),
+            budget: r.budget,
+            samples: r.samples,
+            seconds: r.timing.total(),
+            covariance_s: r.timing.covariance,
+            sampling_s: r.timing.sampling,
+            reconstruction_s: r.timing.reconstruction,
+            allocation_s: r.timing.allocation,
+            rmse: e.rmse,
+            relmse: e.relmse,
+            speedup: None,
+        })
+    }
+}
+
+/// FNV-1a, 64 bits: the cache key of a reference (stable across builds and machines).
+fn fnv(bytes: &[u8], mut h: u64) -> u64 {
+    for &b in bytes {
+        h ^= u64::from(b);
+        h = h.wrapping_mul(0x100_0000_01b3);
+    }
+    h
+}
+
+fn methods(names: &[String]) -> Result<Vec<Method>, String> {
+    if names.is_empty() {
+        return Ok(Method::ALL.to_vec());
+    }
+    let mut out = Vec::new();
+    for n in names {
+        let m = Method::from_name(n.trim()).ok_or_else(|| {
+            format!(
+                "--methods: unknown method `{}` (one of: {})",
+                cov_render::echo(n),
+                Method::ALL.map(Method::name).join(", ")
+            )
+        })?;
+        if !out.contains(&m) {
+            out.push(m);
+        }
+    }
+    if out.iter().any(|m| *m != Method::Uniform) && !out.contains(&Method::Uniform) {
+        // Speed-ups are measured against uniform Monte Carlo: always run it.
+        out.insert(0, Method::Uniform);
+    }
+    Ok(out)
+}
+
+/// Checks the arguments before any work.
+fn check_args(a: &BenchArgs) -> Result<(Vec<Method>, Vec<f64>), String> {
+    if a.budgets.is_empty() || a.budgets.len() > MAX_BUDGETS {
+        return Err(format!(
+            "--budgets: give 1 to {MAX_BUDGETS} values, got {}",
+            a.budgets.len()
+        ));
+    }
+    for &b in &a.budgets {
+        if !(b.is_finite() && (1.0..=f64::from(MAX_SPP)).contains(&b)) {
+            return Err(format!("--budgets: each must be 1 to {MAX_SPP} samples per pixel, got {b}"));
+        }
+    }
+    if a.ref_spp == 0 || a.ref_spp > MAX_SPP {
+        return Err(format!("--ref-spp must be 1 to {MAX_SPP}, got {}", a.ref_spp));
+    }
+    if a.cov_paths == 0 || a.cov_paths > MAX_COV_PATHS {
+        return Err(format!(
+            "--cov-paths must be 1 to {MAX_COV_PATHS}, got {}",
+            a.cov_paths
+        ));
+    }
+    let mut budgets = a.budgets.clone();
+    budgets.sort_by(f64::total_cmp);
+    budgets.dedup();
+    Ok((methods(&a.methods)?, budgets))
+}
+
+/// Creates (if needed) and checks a folder for writing.
+fn folder(dir: &Path, what: &str) -> Result<(), String> {
+    if !dir.is_dir() {
+        std::fs::create_dir(dir).map_err(|e| format!("{what} {}: cannot create it: {e}", dir.display()))?;
+    }
+    crate::render::check_output(&dir.join("probe.json"), "json")
+}
+
+/// The reference image: from the cache when there, else rendered and cached.
+fn reference(a: &BenchArgs, world: &World, text: &[u8], cache: &Path) -> Result<(cov_render::Image, String), String> {
+    let (w, h) = (world.camera.width, world.camera.height);
+    let key = fnv(
+        format!("covtrace-reference-v1 {w}x{h} {} {}", a.ref_spp, a.seed).as_bytes(),
+        fnv(text, 0xcbf2_9ce4_8422_2325),
+    );
+    let exr = cache.join(format!("reference-{key:016x}.exr"));
+    if let Ok(img) = read_image(&exr)
+        && (img.width, img.height) == (w, h)
+        && img.pixels.iter().all(|p| p.is_finite())
+    {
+        return Ok((img, format!("reference: {} (cached)", exr.display())));
+    }
+    let b = bar(tile_count(world), "reference");
+    let counts = vec![a.ref_spp; w as usize * h as usize];
+    let ((img, _), secs) = timed(|| {
+        render_adaptive(
+            world,
+            &counts,
+            a.seed.wrapping_add(0x5eed_0000_0000),
+            Some(&|| b.inc(1)),
+        )
+    });
+    b.finish_and_clear();
+    write_image(&img, &exr, &exr.with_extension("png"))?;
+    Ok((
+        img,
+        format!("reference: {} spp in {secs:.1} s, cached as {}", a.ref_spp, exr.display()),
+    ))
+}
+
+/// Runs `covtrace render-bench`; returns the report.
+///
+/// # Errors
+/// Bad arguments or scene, unwritable outputs.
+pub fn bench(a: &BenchArgs) -> Result<String, String> {
+    let (methods, budgets) = check_args(a)?;
+    let text = std::fs::read(&a.scene).map_err(|e| format!("{}: {e}", a.scene.display()))?;
+    folder(&a.output, "output folder")?;
+    let cache = a.cache.clone().unwrap_or_else(|| a.output.clone());
+    folder(&cache, "cache folder")?;
+    let mut world = World::load(&a.scene).map_err(|e| e.to_string())?;
+    if let Some((w, h)) = a.size {
+        world = world.with_resolution(w, h);
+    }
+    let (w, h) = (world.camera.width, world.camera.height);
+    let mut out = format!("scene: {} ({w}×{h} px)\n", a.scene.display());
+    let (reference, line) = reference(a, &world, &text, &cache)?;
+    out.push_str(&line);
+    out.push('\n');
+    tonemap(&reference)
+        .save(a.output.join("reference.png"))
+        .map_err(|e| format!("{}: {e}", a.output.join("reference.png").display()))?;
+
+    // The covariance pass, once (its time is added to every covariance run).
+    let guide = if methods.iter().any(|m| m.uses_covariance()) {
+        let b = bar(tile_count(&world), "covariance");
+        let (maps, secs) = timed(|| covariance_maps_with(&world, a.cov_paths, a.seed, Some(&|| b.inc(1))));
+        b.finish_and_clear();
+        let g = Guide::new(&maps?, secs);
+        let _ = writeln!(
+            out,
+            "covariance pass: {} paths per pixel, {:.3} s with the filters",
+            a.cov_paths, g.secs
+        );
+        Some(g)
+    } else {
+        None
+    };
+    // Warm-up (caches, the thread pool): one uniform pass at 1 spp, not recorded.
+    run(&world, Method::Uniform, 1.0, None, a.seed ^ 0x77, None)?;
+
+    let total = budgets.len() * methods.len();
+    let b = indicatif::ProgressBar::new(total as u64);
+    b.set_style(
+        indicatif::ProgressStyle::with_template("{msg:12} {bar:40} {pos}/{len} runs [{elapsed}]")
+            .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
+    );
+    b.set_message("render-bench");
+    let mut rows: Vec<Row> = Vec::new();
+    let mut images: Vec<(Method, f64, f64, cov_render::Image)> = Vec::new();
+    for &budget in &budgets {
+        for &m in &methods {
+            let r = run(&world, m, budget, guide.as_ref(), a.seed, None)?;
+            let row = Row::new(&r, &reference)?;
+            images.push((m, budget, row.seconds, r.image));
+            rows.push(row);
+            b.inc(1);
+        }
+    }
+    b.finish_and_clear();
+    let curve = |name: &str| -> Vec<(f64, f64)> {
+        rows.iter()
+            .filter(|r| r.method == name)
+            .map(|r| (r.seconds, r.relmse))
+            .collect()
+    };
+    let uniform = curve("uniform");
+    for r in &mut rows {
+        r.speedup = speedup(&uniform, r.seconds, r.relmse);
+    }
+    write_results(&a.output, &rows, &uniform)?;
+    let chart = a.output.join("error_time.png");
+    let title = format!(
+        "{}: relMSE against wall-clock time ({w}×{h} px, 2-core CPU)",
+        a.scene.file_name().map_or_else(String::new, |s| s.to_string_lossy().into_owned())
+    );
+    for ext in ["png", "svg"] {
+        let p = chart.with_extension(ext);
+        crate::plot::save(&p, (1100, 560), &ErrorChart { rows: &rows, methods: &methods, title: &title })
+            .map_err(|e| format!("{}: {e}", p.display()))?;
+    }
+    let strip = a.output.join("strip.png");
+    let (target, picked) = write_strip(&strip, &images, &rows, &reference)?;
+    out.push_str(&summary(&rows, &methods, &budgets));
+    let _ = writeln!(
+        out,
+        "equal-time strip (≈{target:.2} s per image): {}\nwrote {}, {}, {}, {}, {}",
+        picked,
+        a.output.join("results.csv").display(),
+        a.output.join("results.json").display(),
+        chart.display(),
+        chart.with_extension("svg").display(),
+        strip.display()
+    );
+    Ok(out)
+}
+
+/// The table printed at the end: relMSE per method and budget, the median equal-error
+/// speed-up, and the covariance share of time.
+fn summary(rows: &[Row], methods: &[Method], budgets: &[f64]) -> String {
+    let mut s = String::from("\nrelMSE (seconds) per budget; equal-error speed-up over uniform (median over budgets)\n");
+    let _ = write!(s, "{:<12}", "method");
+    for b in budgets {
+        let _ = write!(s, "{:>20}", format!("{b} spp"));
+    }
+    let _ = writeln!(s, "{:>10}{:>12}", "speed-up", "cov share");
+    for m in methods {
+        let mine: Vec<&Row> = rows.iter().filter(|r| r.method == m.name()).collect();
+        let _ = write!(s, "{:<12}", m.name());
+        for r in &mine {
+            let _ = write!(s, "{:>20}", format!("{:.3e} ({:.2})", r.relmse, r.seconds));
+        }
+        let mut sp: Vec<f64> = mine.iter().filter_map(|r| r.speedup).collect();
+        sp.sort_by(f64::total_cmp);
+        let med = if sp.is_empty() { "n/a".to_string() } else { format!("{:.2}×", sp[sp.len() / 2]) };
+        let share: f64 = mine.iter().map(|r| r.covariance_s / r.seconds.max(1e-12)).sum::<f64>() / mine.len().max(1) as f64;
+        let _ = writeln!(s, "{med:>10}{:>11.1}%", 100.0 * share);
+    }
+    s
+}
+
+fn write_results(dir: &Path, rows: &[Row], uniform: &[(f64, f64)]) -> Result<(), String> {
+    let mut csv = String::from(
+        "method,budget_spp,samples,seconds,covariance_s,sampling_s,reconstruction_s,allocation_s,rmse,relmse,speedup_vs_uniform\n",
+    );
+    for r in rows {
+        let _ = writeln!(
+            csv,
+            "{},{},{},{:.6},{:.6},{:.6},{:.6},{:.6},{:.6e},{:.6e},{}",
+            r.method,
+            r.budget,
+            r.samples,
+            r.seconds,
+            r.covariance_s,
+            r.sampling_s,
+            r.reconstruction_s,
+            r.allocation_s,
+            r.rmse,
+            r.relmse,
+            r.speedup.map_or_else(String::new, |v| format!("{v:.4}"))
+        );
+    }
+    let p = dir.join("results.csv");
+    std::fs::write(&p, csv).map_err(|e| format!("{}: {e}", p.display()))?;
+    let fit = fit_loglog(uniform).map(|(a, b)| serde_json::json!({ "log_relmse_at_1s": a, "slope": b }));
+    let json = serde_json::json!({
+        "units": { "seconds": "wall-clock s", "relmse": "mean over pixels and channels of (I-R)^2/(R^2+0.01)" },
+        "uniform_fit": fit,
+        "runs": rows,
+    });
+    let p = dir.join("results.json");
+    std::fs::write(&p, serde_json::to_string_pretty(&json).map_err(|e| e.to_string())?)
+        .map_err(|e| format!("{}: {e}", p.display()))
+}
+
+/// The log–log chart of relMSE against seconds, a line per method.
+struct ErrorChart<'a> {
+    rows: &'a [Row],
+    methods: &'a [Method],
+    title: &'a str,
+}
+
+impl Picture for ErrorChart<'_> {
+    fn draw<DB: DrawingBackend>(&self, root: DrawingArea<DB, Shift>) -> Result<(), Box<dyn std::error::Error>>
+    where
+        DB::ErrorType: 'static,
+    {
+        root.fill(&WHITE)?;
+        let (w, _) = root.dim_in_pixel();
+        let (left, right) = root.split_horizontally(w.saturating_sub(260));
+        let ok = |r: &&Row| r.seconds > 0.0 && r.relmse > 0.0 && r.relmse.is_finite();
+        let (mut t0, mut t1, mut e0, mut e1) = (f64::MAX, 0.0f64, f64::MAX, 0.0f64);
+        for r in self.rows.iter().filter(ok) {
+            t0 = t0.min(r.seconds);
+            t1 = t1.max(r.seconds);
+            e0 = e0.min(r.relmse);
+            e1 = e1.max(r.relmse);
+        }
+        if !(t0 < t1 && e0 < e1) {
+            (t0, t1, e0, e1) = (1e-2, 1.0, 1e-4, 1.0);
+        }
+        let mut chart = ChartBuilder::on(&left)
+            .caption(self.title, ("sans-serif", 18))
+            .margin(15)
+            .x_label_area_size(45)
+            .y_label_area_size(70)
+            .build_cartesian_2d((t0 / 1.5..t1 * 1.5).log_scale(), (e0 / 1.5..e1 * 1.5).log_scale())?;
+        chart
+            .configure_mesh()
+            .x_label_formatter(&log_tick)
+            .y_label_formatter(&log_tick)
+            .x_desc("wall-clock time [s] (covariance pass included)")
+            .y_desc("relMSE against the reference")
+            .label_style(("sans-serif", 13))
+            .axis_desc_style(("sans-serif", 13))
+            .draw()?;
+        let font = ("sans-serif", 14).into_font().color(&BLACK);
+        right.draw(&Text::new("method", (6, 40), font.clone()))?;
+        for (i, m) in self.methods.iter().enumerate() {
+            let color = COLORS[i % COLORS.len()];
+            let pts: Vec<(f64, f64)> = self
+                .rows
+                .iter()
+                .filter(|r| r.method == m.name())
+                .filter(ok)
+                .map(|r| (r.seconds, r.relmse))
+                .collect();
+            let width = if m.uses_covariance() { 3 } else { 2 };
+            chart.draw_series(LineSeries::new(pts.iter().copied(), color.stroke_width(width)))?;
+            chart.draw_series(pts.iter().map(|&p| Circle::new(p, 4, color.filled())))?;
+            let y = 70 + 24 * i as i32;
+            right.draw(&PathElement::new(vec![(6, y), (34, y)], color.stroke_width(width)))?;
+            right.draw(&Circle::new((20, y), 4, color.filled()))?;
+            right.draw(&Text::new(m.name(), (42, y - 8), font.clone()))?;
+        }
+        root.present()?;
+        Ok(())
+    }
+}
+
+/// Writes the equal-time strip: for each method the run nearest (in log time) to uniform
+/// Monte Carlo's time at the middle budget, beside the reference, each labelled with
+/// method, spp, seconds and relMSE. Returns the target time and what was picked.
+fn write_strip(
+    path: &Path,
+    images: &[(Method, f64, f64, cov_render::Image)],
+    rows: &[Row],
+    reference: &cov_render::Image,
+) -> Result<(f64, String), String> {
+    let uni: Vec<&(Method, f64, f64, cov_render::Image)> =
+        images.iter().filter(|i| i.0 == Method::Uniform).collect();
+    let target = uni.get(uni.len() / 2).map_or(1.0, |u| u.2).max(1e-9);
+    let mut methods: Vec<Method> = Vec::new();
+    for i in images {
+        if !methods.contains(&i.0) {
+            methods.push(i.0);
+        }
+    }
+    let mut panels: Vec<(String, String, &cov_render::Image)> = Vec::new();
+    let mut picked = Vec::new();
+    for m in methods {
+        let best = images
+            .iter()
+            .filter(|i| i.0 == m)
+            .min_by(|a, b| (a.2 / target).ln().abs().total_cmp(&(b.2 / target).ln().abs()));
+        if let Some((m, budget, secs, img)) = best {
+            let rel = rows
+                .iter()
+                .find(|r| r.method == m.name() && r.budget == *budget)
+                .map_or(f64::NAN, |r| r.relmse);
+            panels.push((
+                format!("{} · {budget} spp · {secs:.2} s", m.name()),
+                format!("relMSE {rel:.2e}"),
+                img,
+            ));
+            picked.push(format!("{} {budget} spp", m.name()));
+            let dir = path.parent().unwrap_or(Path::new("."));
+            let name = dir.join(format!("{}.exr", m.name()));
+            write_image(img, &name, &name.with_extension("png"))?;
+            let err = dir.join(format!("{}.error.png", m.name()));
+            cov_render::bench::error_map(img, reference)?
+                .save(&err)
+                .map_err(|e| format!("{}: {e}", err.display()))?;
+        }
+    }
+    panels.push(("reference".into(), String::new(), reference));
+    // Small images are enlarged (nearest pixel) so that labels fit and pixels show.
+    let scale = (300 / reference.width.max(1)).clamp(1, 8);
+    let (iw, ih) = (reference.width * scale, reference.height * scale);
+    let gap = 6u32;
+    let band = 40u32;
+    let (w, h) = (
+        panels.len() as u32 * (iw + gap) + gap,
+        ih + band + gap,
+    );
+    crate::plot::register_font()?;
+    let mut buf = vec![255u8; w as usize * h as usize * 3];
+    {
+        let root = BitMapBackend::with_buffer(&mut buf, (w, h)).into_drawing_area();
+        let font = ("sans-serif", 13).into_font().color(&BLACK);
+        for (k, (a, b, _)) in panels.iter().enumerate() {
+            let x = (gap + k as u32 * (iw + gap)) as i32;
+            root.draw(&Text::new(a.as_str(), (x, 4), font.clone())).map_err(|e| e.to_string())?;
+            root.draw(&Text::new(b.as_str(), (x, 21), font.clone())).map_err(|e| e.to_string())?;
+        }
+        root.present().map_err(|e| e.to_string())?;
+    }
+    let mut pic = image::RgbImage::from_raw(w, h, buf).ok_or("strip buffer size")?;
+    for (k, (_, _, img)) in panels.iter().enumerate() {
+        let t = image::imageops::resize(&tonemap(img), iw, ih, image::imageops::FilterType::Nearest);
+        image::imageops::replace(&mut pic, &t, i64::from(gap + k as u32 * (iw + gap)), i64::from(band));
+    }
+    pic.save(path).map_err(|e| format!("{}: {e}", path.display()))?;
+    Ok((target, picked.join(", ")))
+}

@@ -1,0 +1,386 @@
+//! The film: where samples land, and how they become pixels.
+//!
+//! Each pixel keeps the sums of its own samples, split into the emission of lights seen
+//! directly and the light reflected by surfaces ([`crate::trace::radiance_parts`]), and
+//! the sample statistics of their luminance. Reconstruction ([`Film::image`]) is then a
+//! pass over pixels: emission stays in its pixel (box), and each pixel's reflected sum is
+//! splatted into the pixels around it with **its own** normalised Gaussian filter; a
+//! pixel's value is its emission mean plus the splatted sums over the splatted sample
+//! counts,
+//!
+//! ```text
+//! I_i = E_i / n_i + Σ_j G_j(c_i − c_j) S_j / Σ_j G_j(c_i − c_j) n_j,
+//! ```
+//!
+//! with `c` the pixel centres, `S_j` the reflected sum and `n_j` the count of pixel `j`.
+//! A wide filter spreads a pixel thinly; a narrow one ([`MIN_FILTER_STD`]) keeps it in
+//! place (a neighbour one pixel away weighs 0.4%): the box estimate. Splatting whole pixels
+//! rather than samples costs the footprint once per pixel instead of once per sample and
+//! differs only by where inside a pixel the samples fell (under the narrowest filter).
+//!
+//! Rendering goes tile by tile over rayon and reconstruction band by band; both add their
+//! parts in a fixed order, so images do not depend on the thread count.
+
+use glam::DVec3;
+use rayon::prelude::*;
+
+use crate::render::{Image, Progress, tiles};
+use crate::sampler::{MAX_INDEX, Sampler, SobolSampler};
+use crate::trace::{luminance, radiance_parts};
+use crate::world::World;
+
+/// Largest filter std the film accepts (px); larger ones are clamped. Bounds the margin
+/// a band splats into (3 std).
+pub const MAX_FILTER_STD: f64 = 16.0;
+/// Smallest filter std (px): a pixel one pixel away weighs `exp(−1/(2·0.3²))` = 0.4% of
+/// the pixel itself, so the narrowest filter is the box estimate.
+pub const MIN_FILTER_STD: f64 = 0.3;
+/// A Gaussian is cut at this many standard deviations (its weight there is 1.1%).
+pub const CUTOFF: f64 = 3.0;
+/// Tiles rendered between two merges into the film (bounds the memory of tile results).
+const BATCH: usize = 64;
+
+/// A normalised 2D Gaussian filter in pixels.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Gaussian {
+    /// Precision (inverse covariance) `xx, xy, yy` (1/px²).
+    precision: [f64; 3],
+    /// `1 / (2π √det C)`.
+    norm: f64,
+    /// Larger std (px).
+    std_max: f64,
+}
+
+impl Gaussian {
+    /// The Gaussian of covariance `[xx, xy, yy]` (px²), its eigenvalues clamped to
+    /// `[MIN_FILTER_STD², MAX_FILTER_STD²]`. A non-finite input gives the narrowest filter.
+    pub fn from_cov(c: [f64; 3]) -> Gaussian {
+        let c = if c.iter().all(|v| v.is_finite()) {
+            c
+        } else {
+            [0.0; 3]
+        };
+        // Eigen-decomposition of the symmetric 2×2.
+        let (a, b, d) = (c[0], c[1], c[2]);
+        let mean = 0.5 * (a + d);
+        let r = (0.25 * (a - d) * (a - d) + b * b).sqrt();
+        let (l1, l2) = (mean + r, mean - r);
+        // Unit eigenvector of l1.
+        let (vx, vy) = if b.abs() > 1e-300 {
+            let (x, y) = (l1 - d, b);
+            let n = x.hypot(y);
+            (x / n, y / n)
+        } else if a >= d {
+            (1.0, 0.0)
+        } else {
+            (0.0, 1.0)
+        };
+        let lo = MIN_FILTER_STD * MIN_FILTER_STD;
+        let hi = MAX_FILTER_STD * MAX_FILTER_STD;
+        let (l1, l2) = (l1.clamp(lo, hi), l2.clamp(lo, hi));
+        // Precision = V diag(1/l) Vᵀ with V = [[vx, -vy], [vy, vx]].
+        let (i1, i2) = (1.0 / l1, 1.0 / l2);
+        Gaussian {
+            precision: [
+                vx * vx * i1 + vy * vy * i2,
+                vx * vy * (i1 - i2),
+                vy * vy * i1 + vx * vx * i2,
+            ],
+            norm: 1.0 / (2.0 * std::f64::consts::PI * (l1 * l2).sqrt()),
+            std_max: l1.max(l2).sqrt(),
+        }
+    }
+
+    /// An isotropic Gaussian of std `s` px (clamped as in [`Gaussian::from_cov`]).
+    pub fn isotropic(s: f64) -> Gaussian {
+        Gaussian::from_cov([s * s, 0.0, s * s])
+    }
+
+    /// The larger std (px).
+    pub fn std_max(&self) -> f64 {
+        self.std_max
+    }
+
+    /// The covariance `[xx, xy, yy]` (px²).
+    pub fn cov(&self) -> [f64; 3] {
+        let [p, q, r] = self.precision;
+        let det = p * r - q * q;
+        [r / det, -q / det, p / det]
+    }
+
+    /// The filter's weight at offset `(dx, dy)` px (0 beyond [`CUTOFF`] std).
+    #[inline]
+    pub fn weight(&self, dx: f64, dy: f64) -> f64 {
+        let [p, q, r] = self.precision;
+        let e = p * dx * dx + 2.0 * q * dx * dy + r * dy * dy;
+        if e > CUTOFF * CUTOFF {
+            0.0
+        } else {
+            self.norm * (-0.5 * e).exp()
+        }
+    }
+}
+
+/// How samples are reconstructed into pixels.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Filter {
+    /// Each sample counts in its own pixel only, with weight 1 (the box estimate).
+    Box,
+    /// One Gaussian for every pixel.
+    Fixed(Gaussian),
+    /// A Gaussian per pixel (row by row), used for the samples of that pixel.
+    PerPixel(Vec<Gaussian>),
+}
+
+impl Filter {
+    fn at(&self, i: usize) -> Option<&Gaussian> {
+        match self {
+            Filter::Box => None,
+            Filter::Fixed(g) => Some(g),
+            Filter::PerPixel(v) => v.get(i),
+        }
+    }
+}
+
+/// The accumulated samples of an image.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Film {
+    /// Width (px).
+    pub width: u32,
+    /// Height (px).
+    pub height: u32,
+    /// Samples taken in each pixel so far (the next sample's index in its sequence).
+    pub count: Vec<u32>,
+    /// Sum of the emission each pixel's samples saw directly.
+    pub emitted: Vec<DVec3>,
+    /// Sum of the reflected radiance each pixel's samples saw.
+    pub reflected: Vec<DVec3>,
+    /// Sum of the samples' luminance, and of its square.
+    pub lum: Vec<[f64; 2]>,
+}
+
+/// What one tile hands to the film, per pixel row by row: the sums of emitted and
+/// reflected radiance, the count, the luminance sums.
+type TileOut = Vec<(DVec3, DVec3, u32, [f64; 2])>;
+
+/// Rows of pixels one reconstruction band splats (bands run in parallel).
+const BAND: usize = 16;
+
+impl Film {
+    /// An empty film of `width × height` pixels.
+    pub fn new(width: u32, height: u32) -> Film {
+        let n = width as usize * height as usize;
+        Film {
+            width,
+            height,
+            count: vec![0; n],
+            emitted: vec![DVec3::ZERO; n],
+            reflected: vec![DVec3::ZERO; n],
+            lum: vec![[0.0; 2]; n],
+        }
+    }
+
+    /// The box estimate: each pixel's mean of its own samples (black where it has none).
+    pub fn box_image(&self) -> Image {
+        let pixels = (0..self.count.len())
+            .map(|i| match self.count[i] {
+                0 => DVec3::ZERO,
+                n => (self.emitted[i] + self.reflected[i]) / f64::from(n),
+            })
+            .collect();
+        Image {
+            width: self.width,
+            height: self.height,
+            pixels,
+        }
+    }
+
+    /// The image reconstructed with `filter` (see the module docs); the box estimate for
+    /// [`Filter::Box`] and wherever a pixel received no weight.
+    pub fn image(&self, filter: &Filter) -> Image {
+        if matches!(filter, Filter::Box) {
+            return self.box_image();
+        }
+        let (w, h) = (self.width as usize, self.height as usize);
+        // Each band of rows splats into a buffer with a margin as deep as its filters reach.
+        let bands: Vec<(usize, usize, Vec<(DVec3, f64)>)> = (0..h.div_ceil(BAND))
+            .into_par_iter()
+            .map(|b| {
+                let (y0, y1) = (b * BAND, ((b + 1) * BAND).min(h));
+                let reach = (y0 * w..y1 * w)
+                    .filter_map(|i| filter.at(i))
+                    .map(|g| (CUTOFF * g.std_max).ceil() as usize)
+                    .max()
+                    .unwrap_or(0);
+                let top = y0.saturating_sub(reach);
+                let bottom = (y1 + reach).min(h);
+                let mut buf = vec![(DVec3::ZERO, 0.0); (bottom - top) * w];
+                for y in y0..y1 {
+                    for x in 0..w {
+                        let i = y * w + x;
+                        let (n, s) = (f64::from(self.count[i]), self.reflected[i]);
+                        let Some(g) = filter.at(i) else { continue };
+                        if n == 0.0 {
+                            continue;
+                        }
+                        let r = (CUTOFF * g.std_max).ceil() as usize;
+                        for py in y.saturating_sub(r)..(y + r + 1).min(h) {
+                            let dy = py as f64 - y as f64;
+                            let row = (py - top) * w;
+                            for px in x.saturating_sub(r)..(x + r + 1).min(w) {
+                                let wgt = g.weight(px as f64 - x as f64, dy);
+                                if wgt > 0.0 {
+                                    let e = &mut buf[row + px];
+                                    e.0 += s * wgt;
+                                    e.1 += n * wgt;
+                                }
+                            }
+                        }
+                    }
+                }
+                (top, bottom, buf)
+            })
+            .collect();
+        let mut acc = vec![(DVec3::ZERO, 0.0); w * h];
+        for (top, _, buf) in bands {
+            for (k, v) in buf.into_iter().enumerate() {
+                let e = &mut acc[top * w + k];
+                e.0 += v.0;
+                e.1 += v.1;
+            }
+        }
+        let mut img = self.box_image();
+        for (i, p) in img.pixels.iter_mut().enumerate() {
+            let (s, wsum) = acc[i];
+            if wsum > 0.0 && self.count[i] > 0 {
+                *p = self.emitted[i] / f64::from(self.count[i]) + s / wsum;
+            }
+        }
+        img
+    }
+
+    /// Per pixel, the sample variance of the luminance of its own samples (0 with fewer
+    /// than two).
+    pub fn variance(&self) -> Vec<f64> {
+        self.lum
+            .iter()
+            .zip(&self.count)
+            .map(|(&[s, s2], &n)| {
+                if n < 2 {
+                    return 0.0;
+                }
+                let nf = f64::from(n);
+                let m = s / nf;
+                ((s2 - nf * m * m) / (nf - 1.0)).max(0.0)
+            })
+            .collect()
+    }
+
+    /// Takes `counts[i]` more samples in pixel `i`, continuing each pixel's sequence (a
+    /// pixel never takes more than [`crate::MAX_SPP`] in all). Each sample's luminance is
+    /// clamped to `max_luminance` (colour scaled down; `∞` for an unbiased image).
+    pub fn render(
+        &mut self,
+        world: &World,
+        counts: &[u32],
+        seed: u64,
+        max_luminance: f64,
+        progress: Progress<'_>,
+    ) {
+        let w = self.width;
+        let tl = tiles(self.width, self.height);
+        for batch in tl.chunks(BATCH) {
+            let outs: Vec<TileOut> = batch
+                .par_iter()
+                .map(|&t| {
+                    let out = self.tile(world, counts, seed, max_luminance, t);
+                    if let Some(p) = progress {
+                        p();
+                    }
+                    out
+                })
+                .collect();
+            for (&(x0, y0, x1, y1), out) in batch.iter().zip(outs) {
+                let coords = (y0..y1).flat_map(|y| (x0..x1).map(move |x| (y * w + x) as usize));
+                for (i, (e, r, n, l)) in coords.zip(out) {
+                    self.emitted[i] += e;
+                    self.reflected[i] += r;
+                    self.count[i] += n;
+                    self.lum[i][0] += l[0];
+                    self.lum[i][1] += l[1];
+                }
+            }
+        }
+    }
+
+    /// Renders one tile (its samples come from per-pixel sequences).
+    fn tile(
+        &self,
+        world: &World,
+        counts: &[u32],
+        seed: u64,
+        max_luminance: f64,
+        (x0, y0, x1, y1): (u32, u32, u32, u32),
+    ) -> TileOut {
+        let w = self.width;
+        let mut out = Vec::with_capacity(((x1 - x0) * (y1 - y0)) as usize);
+        for y in y0..y1 {
+            for x in x0..x1 {
+                let i = (y * w + x) as usize;
+                let first = self.count[i].min(MAX_INDEX);
+                let n = counts.get(i).copied().unwrap_or(0).min(MAX_INDEX - first);
+                let mut sampler = SobolSampler::new(seed, w, x, y);
+                let (mut se, mut sr, mut l1, mut l2) = (DVec3::ZERO, DVec3::ZERO, 0.0, 0.0);
+                for s in first..first + n {
+                    sampler.start(s);
+                    let s = &mut sampler;
+                    let (jx, jy, lu, lv, ut) = (s.next(), s.next(), s.next(), s.next(), s.next());
+                    let ray = world.camera.ray(x as f64 + jx, y as f64 + jy, (lu, lv), ut);
+                    let (e, r) = radiance_parts(world, &ray, s);
+                    let (e, r) = if (e + r).is_finite() { (e, r) } else { (DVec3::ZERO, DVec3::ZERO) };
+                    let yl = luminance(e + r);
+                    let (e, r) = if yl > max_luminance {
+                        let k = max_luminance / yl;
+                        (e * k, r * k)
+                    } else {
+                        (e, r)
+                    };
+                    let yl = luminance(e + r);
+                    se += e;
+                    sr += r;
+                    l1 += yl;
+                    l2 += yl * yl;
+                }
+                out.push((se, sr, n, [l1, l2]));
+            }
+        }
+        out
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn gaussians_are_normalised_and_clamped() {
+        for c in [[4.0, 1.0, 2.0], [1.0, 0.0, 9.0], [0.01, 0.0, 0.01], [1e9, 0.0, 1.0]] {
+            let g = Gaussian::from_cov(c);
+            // ∑ over a fine grid ≈ 1.
+            let h = 0.05;
+            let mut s = 0.0;
+            let r = (CUTOFF * g.std_max() / h).ceil() as i64 + 1;
+            for i in -r..=r {
+                for j in -r..=r {
+                    s += g.weight(i as f64 * h, j as f64 * h) * h * h;
+                }
+            }
+            assert!((s - 0.9889).abs() < 0.01, "{c:?}: mass {s}");
+            assert!(g.std_max() <= MAX_FILTER_STD + 1e-9 && g.std_max() >= MIN_FILTER_STD - 1e-9);
+        }
+        let g = Gaussian::from_cov([4.0, 1.0, 2.0]);
+        let c = g.cov();
+        assert!((c[0] - 4.0).abs() < 1e-9 && (c[1] - 1.0).abs() < 1e-9 && (c[2] - 2.0).abs() < 1e-9);
+        assert_eq!(Gaussian::from_cov([f64::NAN, 0.0, 1.0]), Gaussian::isotropic(0.0));
+    }
+}
