@@ -152,6 +152,7 @@ impl CovBlock {
     }
 
     /// Entry `(i, j)`; indices must be `< len()`.
+    #[inline]
     pub fn get(&self, i: usize, j: usize) -> f64 {
         assert!(i < self.len() && j < self.len(), "index out of range");
         self.m[i][j]

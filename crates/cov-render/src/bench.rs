@@ -155,35 +155,26 @@ pub fn filter_cov(p: &PixelCov) -> [f64; 3] {
     }
 }
 
-/// Every pixel's Gaussian from the maps, each narrowed so that it does not reach an
-/// edge the pass saw nearby ([`EDGE_REACH`]).
-pub fn filters(maps: &CovMaps) -> Vec<Gaussian> {
+/// Narrows every filter so that it does not reach, at [`EDGE_REACH`] of its own std, a
+/// pixel whose filter is narrower than the distance to it over [`EDGE_REACH`]: a wide
+/// filter stops short of an edge the covariance pass saw a few pixels away.
+pub fn edge_clamp(width: u32, height: u32, raw: &[Gaussian]) -> Vec<Gaussian> {
     use rayon::prelude::*;
-    let (w, h) = (maps.width as i64, maps.height as i64);
-    let raw: Vec<Gaussian> = maps
-        .pixels
-        .par_iter()
-        .map(|p| {
-            let s: f64 = std::env::var("XS").ok().and_then(|v| v.parse().ok()).unwrap_or(1.0);
-            let c = filter_cov(p);
-            Gaussian::from_cov([c[0] * s * s, c[1] * s * s, c[2] * s * s])
-        })
-        .collect();
-    let edge_reach: f64 = std::env::var("XE").ok().and_then(|v| v.parse().ok()).unwrap_or(EDGE_REACH);
+    let (w, h) = (i64::from(width), i64::from(height));
     (0..w * h)
         .into_par_iter()
         .map(|i| {
             let g = raw[i as usize];
             let s = g.std_max();
             let (x, y) = (i % w, i / w);
-            let r = (edge_reach * s).ceil() as i64;
+            let r = (EDGE_REACH * s).ceil() as i64;
             let mut limit = s;
             for yy in (y - r).max(0)..=(y + r).min(h - 1) {
                 for xx in (x - r).max(0)..=(x + r).min(w - 1) {
                     let sk = raw[(yy * w + xx) as usize].std_max();
                     if sk < limit {
                         let d = (((xx - x) * (xx - x) + (yy - y) * (yy - y)) as f64).sqrt();
-                        limit = limit.min(sk.max(d / edge_reach));
+                        limit = limit.min(sk.max(d / EDGE_REACH));
                     }
                 }
             }
@@ -198,25 +189,108 @@ pub fn filters(maps: &CovMaps) -> Vec<Gaussian> {
         .collect()
 }
 
-/// The covariance pass's products a method uses: sample weights and filters.
+/// The largest scale `k²` of a pixel's matched filter `F₀` ([`filter_cov`]): `k = 1` is
+/// the Gaussian whose spectrum matches the content's, where the model's relative bias is
+/// already `1 − 1/(1 + k²)` = 50%.
+pub const K2_MAX: f64 = 1.0;
+
+/// The share `m²` of a pixel's squared signal that its local spectrum's detail carries,
+/// in the bias term of [`adapted_filters`]. Σ gives the spread of the local spectrum, not
+/// how much of the signal lies away from its mean; `m² = 1` (all of it) is the pessimistic
+/// bound. 0.1 was chosen on the bundled Cornell scene at 256×192 from {1, 0.1, 0.01,
+/// 0.001} (relMSE at 2 to 64 spp; 0.01 is within 10% of it, 1 and 0.001 are 20–130% worse),
+/// and is kept for every scene.
+pub const MODULATION: f64 = 0.1;
+
+/// Each pixel's filter for the samples in `film`: its matched filter `F₀` scaled by the
+/// `k²` that minimises the predicted squared error
+///
+/// ```text
+/// MSE(k) = m² k⁴ I² + v / (4π n k² √det F₀)
+/// ```
+///
+/// (the bias of a filter `k² F₀` on a Gaussian spectrum is `1 − 1/(1 + k²) ≈ k²` of the
+/// detail `m I` ([`MODULATION`]); the noise of `n` samples of variance `v` averaged by a
+/// normalised Gaussian of covariance `k² F₀` px² is `v / (4π n k² √det F₀)`), so
+/// `k⁶ = v / (8π m² n (I² + ε) √det F₀)`, capped at [`K2_MAX`]. `v` is the 3×3 mean of the pixels' sample variances (from the
+/// spread of the 3×3 pixel means where pixels hold one sample), `I` the 3×3 largest
+/// luminance; then [`edge_clamp`]. More samples or less noise give narrower filters.
+pub fn adapted_filters(guide: &Guide, film: &Film) -> Vec<Gaussian> {
+    use rayon::prelude::*;
+    let (w, h) = (i64::from(film.width), i64::from(film.height));
+    let var = film.variance();
+    let img = film.box_image();
+    let lum: Vec<f64> = img.pixels.iter().map(|p| luminance(*p)).collect();
+    let raw: Vec<Gaussian> = (0..w * h)
+        .into_par_iter()
+        .map(|i| {
+            let (x, y) = (i % w, i / w);
+            let (mut v, mut imax, mut m1, mut m2, mut k) = (0.0, 0.0f64, 0.0, 0.0, 0.0);
+            for yy in (y - 1).max(0)..=(y + 1).min(h - 1) {
+                for xx in (x - 1).max(0)..=(x + 1).min(w - 1) {
+                    let j = (yy * w + xx) as usize;
+                    v += var[j];
+                    imax = imax.max(lum[j]);
+                    m1 += lum[j];
+                    m2 += lum[j] * lum[j];
+                    k += 1.0;
+                }
+            }
+            let n = f64::from(film.count[i as usize].max(1));
+            let v = if film.count[i as usize] >= 2 {
+                v / k
+            } else {
+                n * ((m2 - m1 * m1 / k) / (k - 1.0).max(1.0)).max(0.0)
+            };
+            let f0 = guide.matched[i as usize];
+            let det = (f0[0] * f0[2] - f0[1] * f0[1]).max(1e-12);
+            let k6 = v / (8.0 * std::f64::consts::PI * n * (imax * imax + REL_EPS) * det.sqrt());
+            let k2 = (k6 / MODULATION).cbrt().min(K2_MAX);
+            Gaussian::from_cov([f0[0] * k2, f0[1] * k2, f0[2] * k2])
+        })
+        .collect();
+    edge_clamp(film.width, film.height, &raw)
+}
+
+/// The covariance pass's products a method uses: sample weights and matched filters.
 #[derive(Clone, Debug)]
 pub struct Guide {
     /// Predicted samples per pixel (relative weights for allocation).
     pub density: Vec<f64>,
-    /// Per-pixel reconstruction filters.
-    pub filters: Vec<Gaussian>,
-    /// Seconds the covariance pass and the filters took.
+    /// Per-pixel matched filter covariance `F₀` `[xx, xy, yy]` (px², [`filter_cov`]).
+    pub matched: Vec<[f64; 3]>,
+    /// Seconds the covariance pass took.
     pub secs: f64,
 }
 
 impl Guide {
     /// The guide of `maps`, which took `pass_secs` to trace.
     pub fn new(maps: &CovMaps, pass_secs: f64) -> Guide {
+        use rayon::prelude::*;
         let t = Instant::now();
-        let filters = filters(maps);
+        // Rows in parallel; a pixel equal to its left neighbour (a block of the strided
+        // grid) reuses its filter.
+        let w = maps.width as usize;
+        let matched: Vec<[f64; 3]> = maps
+            .pixels
+            .par_chunks(w.max(1))
+            .flat_map_iter(|row| {
+                let mut last: Option<(PixelCov, [f64; 3])> = None;
+                row.iter()
+                    .map(|p| match last {
+                        Some((q, f)) if q == *p => f,
+                        _ => {
+                            let f = filter_cov(p);
+                            last = Some((*p, f));
+                            f
+                        }
+                    })
+                    .collect::<Vec<_>>()
+            })
+            .collect();
         Guide {
             density: maps.pixels.iter().map(|p| p.spp).collect(),
-            filters,
+            matched,
             secs: pass_secs + t.elapsed().as_secs_f64(),
         }
     }
@@ -282,7 +356,7 @@ pub fn run(
     let total = budget * n as f64;
     let hi = ((budget * MAX_RATIO).ceil() as u32).clamp(1, MAX_SPP);
     let guide = match (method.uses_covariance(), guide) {
-        (true, Some(g)) if g.filters.len() == n && g.density.len() == n => Some(g),
+        (true, Some(g)) if g.matched.len() == n && g.density.len() == n => Some(g),
         (true, _) => {
             return Err(format!(
                 "method `{}` needs the covariance maps of this {w}x{h} image",
@@ -299,7 +373,6 @@ pub fn run(
     let mut film = Film::new(w, h);
     let filter = match method {
         Method::Gauss => Filter::Fixed(Gaussian::isotropic(FIXED_STD)),
-        Method::CovFilter | Method::Cov => Filter::PerPixel(guide.map(|g| g.filters.clone()).unwrap_or_default()),
         _ => Filter::Box,
     };
     match method {
@@ -308,7 +381,8 @@ pub fn run(
         }
         Method::CovDensity | Method::Cov => {
             let t = Instant::now();
-            let counts = allocate(&guide.map(|g| g.density.clone()).unwrap_or_default(), total, 1, hi);
+            let lo = ((budget / 4.0).floor() as u32).max(1);
+            let counts = allocate(&guide.map(|g| g.density.clone()).unwrap_or_default(), total, lo, hi);
             timing.allocation = t.elapsed().as_secs_f64();
             timing.sample(|| film.render(world, &counts, seed, f64::INFINITY, progress));
         }
@@ -336,6 +410,10 @@ pub fn run(
         }
     }
     let t = Instant::now();
+    let filter = match (method, guide) {
+        (Method::CovFilter | Method::Cov, Some(g)) => Filter::PerPixel(adapted_filters(g, &film)),
+        _ => filter,
+    };
     let image = film.image(&filter);
     timing.reconstruction += t.elapsed().as_secs_f64();
     Ok(Run {

@@ -108,6 +108,51 @@ impl Gaussian {
         [r / det, -q / det, p / det]
     }
 
+    /// Calls `add(cell, weight)` for the cells `x − r ..= x + r` of `row` (clipped to it) at
+    /// vertical offset `dy`, with the weight at offset `(cell − x, dy)` where it is inside
+    /// the [`CUTOFF`] ellipse. Walks outward from the row's peak with the Gaussian's
+    /// ratio recurrence (two products a cell, one `exp` per direction and row), so the
+    /// weights only decrease along a walk and underflow stops it, never skips a cell.
+    pub fn splat_row<T>(&self, row: &mut [T], x: usize, dy: f64, r: usize, mut add: impl FnMut(&mut T, f64)) {
+        let [p, q, rr] = self.precision;
+        let lo = x.saturating_sub(r) as i64 - x as i64;
+        let hi = ((x + r).min(row.len().saturating_sub(1)) as i64) - x as i64;
+        if lo > hi {
+            return;
+        }
+        let e_at = |dx: f64| p * dx * dx + 2.0 * q * dx * dy + rr * dy * dy;
+        let c = ((-q * dy / p).round() as i64).clamp(lo, hi);
+        let cut = CUTOFF * CUTOFF;
+        let decay = (-p).exp();
+        // Rightwards from the peak c.
+        let (mut e, mut wgt) = (e_at(c as f64), self.norm * (-0.5 * e_at(c as f64)).exp());
+        let mut ratio = (-0.5 * p * (2 * c + 1) as f64 - q * dy).exp();
+        for dx in c..=hi {
+            if e > cut || wgt == 0.0 {
+                break;
+            }
+            add(&mut row[(x as i64 + dx) as usize], wgt);
+            e += p * (2 * dx + 1) as f64 + 2.0 * q * dy;
+            wgt *= ratio;
+            ratio *= decay;
+        }
+        // Leftwards from c − 1.
+        if c > lo {
+            let d = c - 1;
+            let (mut e, mut wgt) = (e_at(d as f64), self.norm * (-0.5 * e_at(d as f64)).exp());
+            let mut ratio = (0.5 * p * (2 * d - 1) as f64 + q * dy).exp();
+            for dx in (lo..=d).rev() {
+                if e > cut || wgt == 0.0 {
+                    break;
+                }
+                add(&mut row[(x as i64 + dx) as usize], wgt);
+                e -= p * (2 * dx - 1) as f64 + 2.0 * q * dy;
+                wgt *= ratio;
+                ratio *= decay;
+            }
+        }
+    }
+
     /// The filter's weight at offset `(dx, dy)` px (0 beyond [`CUTOFF`] std).
     #[inline]
     pub fn weight(&self, dx: f64, dy: f64) -> f64 {
@@ -225,16 +270,11 @@ impl Film {
                         }
                         let r = (CUTOFF * g.std_max).ceil() as usize;
                         for py in y.saturating_sub(r)..(y + r + 1).min(h) {
-                            let dy = py as f64 - y as f64;
-                            let row = (py - top) * w;
-                            for px in x.saturating_sub(r)..(x + r + 1).min(w) {
-                                let wgt = g.weight(px as f64 - x as f64, dy);
-                                if wgt > 0.0 {
-                                    let e = &mut buf[row + px];
-                                    e.0 += s * wgt;
-                                    e.1 += n * wgt;
-                                }
-                            }
+                            let row = &mut buf[(py - top) * w..(py - top + 1) * w];
+                            g.splat_row(row, x, py as f64 - y as f64, r, |e, wgt| {
+                                e.0 += s * wgt;
+                                e.1 += n * wgt;
+                            });
                         }
                     }
                 }
@@ -382,5 +422,25 @@ mod tests {
         let c = g.cov();
         assert!((c[0] - 4.0).abs() < 1e-9 && (c[1] - 1.0).abs() < 1e-9 && (c[2] - 2.0).abs() < 1e-9);
         assert_eq!(Gaussian::from_cov([f64::NAN, 0.0, 1.0]), Gaussian::isotropic(0.0));
+    }
+
+    /// The row walk gives the weights `weight` gives, cell by cell, and no others.
+    #[test]
+    fn row_walk_matches_the_weights() {
+        for c in [[4.0, 1.5, 2.0], [9.0, -2.9, 1.0], [0.09, 0.0, 0.09], [200.0, 0.0, 0.2]] {
+            let g = Gaussian::from_cov(c);
+            let r = (CUTOFF * g.std_max()).ceil() as usize;
+            for x in [0usize, 3, r, 40] {
+                for dy in -(r as i64)..=(r as i64) {
+                    let mut row = vec![0.0; 50];
+                    g.splat_row(&mut row, x, dy as f64, r, |e, w| *e += w);
+                    for (k, v) in row.iter().enumerate() {
+                        let dx = k as f64 - x as f64;
+                        let want = if dx.abs() <= r as f64 { g.weight(dx, dy as f64) } else { 0.0 };
+                        assert!((v - want).abs() <= 1e-12 * g.norm, "{c:?} x {x} dy {dy} cell {k}: {v} vs {want}");
+                    }
+                }
+            }
+        }
     }
 }

@@ -143,8 +143,10 @@ pub struct CovMaps {
     pub height: u32,
     /// Per pixel.
     pub pixels: Vec<PixelCov>,
-    /// Covariance paths traced per pixel.
-    pub paths_per_pixel: u32,
+    /// Covariance paths traced per block of the grid.
+    pub paths_per_block: u32,
+    /// Side of the grid's blocks (px; 1: a prediction per pixel).
+    pub stride: u32,
     /// Layout the paths were traced in.
     pub layout: usize,
 }
@@ -168,6 +170,31 @@ pub fn covariance_maps_with(
     seed: u64,
     progress: Progress<'_>,
 ) -> Result<CovMaps, String> {
+    covariance_maps_strided(world, paths, 1, seed, progress)
+}
+
+/// Strides of the covariance grid [`covariance_maps_strided`] accepts (they divide a tile).
+pub const STRIDES: [u32; 5] = [1, 2, 4, 8, 16];
+
+/// Traces `paths` covariance paths per block of `stride × stride` pixels (jittered over
+/// the block and the shutter); every pixel of a block gets the block's prediction. A
+/// coarser grid costs `stride²` times less; a block that holds an edge predicts for all
+/// its pixels the detail that its paths saw (radiance-weighted), so edges widen to the
+/// block, which narrows filters and raises densities near them (conservative).
+///
+/// # Errors
+/// A stride not in [`STRIDES`]; an operator that rejects what the scene gives it, with the
+/// pixel it happened at.
+pub fn covariance_maps_strided(
+    world: &World,
+    paths: u32,
+    stride: u32,
+    seed: u64,
+    progress: Progress<'_>,
+) -> Result<CovMaps, String> {
+    if !STRIDES.contains(&stride) {
+        return Err(format!("the covariance grid's stride must be one of {STRIDES:?}, got {stride}"));
+    }
     let paths = paths.clamp(1, MAX_COV_PATHS);
     let cc = CovCamera::new(world).map_err(|e| e.to_string())?;
     let (w, h) = (world.camera.width, world.camera.height);
@@ -177,41 +204,16 @@ pub fn covariance_maps_with(
         .enumerate()
         .map(|(index, &(x0, y0, x1, y1))| {
             let mut rng = tile_rng(seed, 1, index);
-            let mut out = Vec::new();
-            for y in y0..y1 {
-                for x in x0..x1 {
-                    let mut acc = PixelCov::default();
-                    let (mut plain, mut n_plain) = ([0.0; 3], 0.0);
-                    let mut plain_spp = 0.0;
-                    for _ in 0..paths {
-                        let (jx, jy, ut) = (rng.random::<f64>(), rng.random::<f64>(), rng.random::<f64>());
-                        let r = trace_path(world, &cc, x as f64 + jx, y as f64 + jy, ut, &mut rng)
-                            .map_err(|e| format!("covariance path at pixel ({x}, {y}): {e}"))?;
-                        let Some((d, wgt)) = r else { continue };
-                        let s = [d.image_cov_px[0][0], d.image_cov_px[0][1], d.image_cov_px[1][1]];
-                        if !(s.iter().all(|v| v.is_finite()) && d.samples_per_pixel.is_finite()) {
-                            continue;
+            let mut out = vec![PixelCov::default(); ((x1 - x0) * (y1 - y0)) as usize];
+            for by in (y0..y1).step_by(stride as usize) {
+                for bx in (x0..x1).step_by(stride as usize) {
+                    let (sx, sy) = ((x1 - bx).min(stride), (y1 - by).min(stride));
+                    let acc = block_cov(world, &cc, (bx, by), (sx, sy), paths, &mut rng)?;
+                    for y in by..by + sy {
+                        for x in bx..bx + sx {
+                            out[((y - y0) * (x1 - x0) + (x - x0)) as usize] = acc;
                         }
-                        for k in 0..3 {
-                            acc.sigma[k] += wgt * s[k];
-                            plain[k] += s[k];
-                        }
-                        acc.spp += wgt * d.samples_per_pixel;
-                        acc.weight += wgt;
-                        plain_spp += d.samples_per_pixel;
-                        n_plain += 1.0;
                     }
-                    if acc.weight > 0.0 {
-                        for k in 0..3 {
-                            acc.sigma[k] /= acc.weight;
-                        }
-                        acc.spp /= acc.weight;
-                    } else if n_plain > 0.0 {
-                        // No path carried light: the geometry's content, unweighted.
-                        acc.sigma = plain.map(|v| v / n_plain);
-                        acc.spp = plain_spp / n_plain;
-                    }
-                    out.push(acc);
                 }
             }
             if let Some(p) = progress {
@@ -224,9 +226,58 @@ pub fn covariance_maps_with(
         width: w,
         height: h,
         pixels: assemble(w, h, &tl, results?, PixelCov::default()),
-        paths_per_pixel: paths,
+        paths_per_block: paths,
+        stride,
         layout: cc.layout(),
     })
+}
+
+/// The radiance-weighted mean prediction of `paths` paths through the block of `size`
+/// pixels at `at`.
+fn block_cov(
+    world: &World,
+    cc: &CovCamera,
+    (x, y): (u32, u32),
+    (sx, sy): (u32, u32),
+    paths: u32,
+    rng: &mut ChaCha8Rng,
+) -> Result<PixelCov, String> {
+    let mut acc = PixelCov::default();
+    let (mut plain, mut n_plain, mut plain_spp) = ([0.0; 3], 0.0, 0.0);
+    for _ in 0..paths {
+        let (jx, jy, ut) = (
+            rng.random::<f64>() * f64::from(sx),
+            rng.random::<f64>() * f64::from(sy),
+            rng.random::<f64>(),
+        );
+        let (px, py) = (f64::from(x) + jx, f64::from(y) + jy);
+        let r = trace_path(world, cc, px, py, ut, rng)
+            .map_err(|e| format!("covariance path at pixel ({}, {}): {e}", px.floor(), py.floor()))?;
+        let Some((d, wgt)) = r else { continue };
+        let s = [d.image_cov_px[0][0], d.image_cov_px[0][1], d.image_cov_px[1][1]];
+        if !(s.iter().all(|v| v.is_finite()) && d.samples_per_pixel.is_finite()) {
+            continue;
+        }
+        for k in 0..3 {
+            acc.sigma[k] += wgt * s[k];
+            plain[k] += s[k];
+        }
+        acc.spp += wgt * d.samples_per_pixel;
+        acc.weight += wgt;
+        plain_spp += d.samples_per_pixel;
+        n_plain += 1.0;
+    }
+    if acc.weight > 0.0 {
+        for k in 0..3 {
+            acc.sigma[k] /= acc.weight;
+        }
+        acc.spp /= acc.weight;
+    } else if n_plain > 0.0 {
+        // No path carried light: the geometry's content, unweighted.
+        acc.sigma = plain.map(|v| v / n_plain);
+        acc.spp = plain_spp / n_plain;
+    }
+    Ok(acc)
 }
 
 /// Runs `f`, returning its result and the seconds it took.
@@ -351,7 +402,8 @@ pub fn write_maps(
         "width": maps.width,
         "height": maps.height,
         "layout": maps.layout,
-        "paths_per_pixel": maps.paths_per_pixel,
+        "paths_per_block": maps.paths_per_block,
+        "block_px": maps.stride,
         "units": { "sigma": "(cycles/px)^2, [xx, xy, yy] per pixel", "spp": "samples per pixel over pixel x lens x time" },
         "sigma": maps.pixels.iter().flat_map(|p| p.sigma).collect::<Vec<f64>>(),
         "spp": maps.pixels.iter().map(|p| p.spp).collect::<Vec<f64>>(),

@@ -31,3 +31,98 @@ fn filters_agree_with_the_box_on_a_flat_image() {
         assert!((p.y - q.y).abs() < 0.05 * p.y, "pixel {k}: box {p}, gauss {q}");
     }
 }
+
+/// Reconstruction is a normalised average: a film whose pixels all hold the same mean
+/// gives that mean back exactly, whatever the counts and the per-pixel filters.
+#[test]
+fn reconstruction_keeps_a_constant_under_any_filters() {
+    use glam::DVec3;
+    let (w, h) = (23u32, 17u32);
+    let mut film = Film::new(w, h);
+    let c = DVec3::new(0.3, 1.7, 42.0);
+    let mut filters = Vec::new();
+    for i in 0..(w * h) as usize {
+        let n = 1 + (i * 7919 % 13) as u32;
+        film.count[i] = n;
+        film.reflected[i] = c * f64::from(n);
+        let a = 0.05 + (i % 11) as f64;
+        filters.push(Gaussian::from_cov([a, 0.3 * a * ((i % 3) as f64 - 1.0), 1.0 + (i % 5) as f64]));
+    }
+    for f in [Filter::Box, Filter::Fixed(Gaussian::isotropic(2.0)), Filter::PerPixel(filters)] {
+        for p in film.image(&f).pixels {
+            assert!((p - c).abs().max_element() <= 1e-12 * c.max_element(), "{f:?}: {p}");
+        }
+    }
+}
+
+/// Adaptive counts and a second pass that continues each pixel's sequence keep the box
+/// estimate unbiased: a diffuse plane under a sphere light (closed form `ρ L (R/D)²`, see
+/// tests/render.rs) estimated from 3 001 then 9 000 more samples matches within 4σ.
+#[test]
+fn a_two_pass_estimate_matches_the_closed_form() {
+    let text = r#"Scene(
+        camera: (position: (0.0, 1.0, 0.0), look_at: (0.0, 0.0, 0.0), up: (0.0, 0.0, -1.0), fov: 0.5, width: 1, height: 1),
+        materials: { "grey": Diffuse(albedo: (0.5, 0.5, 0.5)) },
+        lights: [Sphere(center: (0.0, 2.0, 0.0), radius: 0.5, radiance: (1.0, 1.0, 1.0))],
+        shapes: [Quad(corner: (-50.0, 0.0, -50.0), edge_u: (100.0, 0.0, 0.0), edge_v: (0.0, 0.0, 100.0), material: "grey")],
+    )"#;
+    let world = World::from_text(text, "<test>", Path::new(".")).unwrap();
+    let mut film = Film::new(1, 1);
+    film.render(&world, &[3001], 5, f64::INFINITY, None);
+    film.render(&world, &[9000], 5, f64::INFINITY, None);
+    assert_eq!(film.count[0], 12001);
+    let got = film.box_image().pixels[0].y;
+    let exact = 0.5 * (0.5f64 / 2.0).powi(2);
+    let stderr = (film.variance()[0] / 12001.0).sqrt();
+    assert!(stderr > 0.0 && (got - exact).abs() <= 4.0 * stderr, "got {got}, closed form {exact} ± {stderr}");
+}
+
+fn scene(name: &str, w: u32, h: u32) -> World {
+    let p = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/scenes").join(name);
+    World::load(&p).unwrap_or_else(|e| panic!("{e}")).with_resolution(w, h)
+}
+
+/// Every method runs on every bundled scene, spends its budget, and gives a finite,
+/// non-negative image; the covariance methods need the covariance pass.
+#[test]
+fn every_method_runs_on_every_scene() {
+    use cov_render::bench::{Guide, Method, error, run};
+    use cov_render::render::covariance_maps_strided;
+    for name in ["cornell.ron", "pool.ron", "glossy.ron"] {
+        let world = scene(name, 24, 16);
+        let maps = covariance_maps_strided(&world, 1, 4, 1, None).unwrap();
+        assert_eq!(maps.stride, 4);
+        let guide = Guide::new(&maps, 0.0);
+        let reference = cov_render::render(&world, 16, 99);
+        for m in Method::ALL {
+            let r = run(&world, m, 6.0, Some(&guide), 1, None).unwrap();
+            assert!(
+                r.image.pixels.iter().all(|p| p.is_finite() && p.min_element() >= 0.0),
+                "{name} {m:?}"
+            );
+            // Rounding moves at most one sample per pixel.
+            assert!((r.samples as f64 - 6.0 * 24.0 * 16.0).abs() <= 24.0 * 16.0, "{name} {m:?}: {} samples", r.samples);
+            let e = error(&r.image, &reference).unwrap();
+            assert!(e.rmse.is_finite() && e.relmse.is_finite(), "{name} {m:?}");
+            assert!(r.timing.total() > 0.0);
+            if m.uses_covariance() {
+                assert!(run(&world, m, 6.0, None, 1, None).is_err(), "{m:?} without a guide");
+            }
+        }
+    }
+}
+
+/// On a scene of smooth light, filtering removes most of the noise: the covariance filter
+/// at 4 spp is closer to a 256-spp reference than the box filter at 4 spp.
+#[test]
+fn the_covariance_filter_lowers_the_error_of_a_noisy_image() {
+    use cov_render::bench::{Guide, Method, error, run};
+    use cov_render::render::covariance_maps_strided;
+    let world = scene("cornell.ron", 64, 48);
+    let reference = cov_render::render(&world, 256, 77);
+    let guide = Guide::new(&covariance_maps_strided(&world, 1, 4, 1, None).unwrap(), 0.0);
+    let uni = run(&world, Method::Uniform, 4.0, None, 1, None).unwrap();
+    let cov = run(&world, Method::CovFilter, 4.0, Some(&guide), 1, None).unwrap();
+    let (eu, ec) = (error(&uni.image, &reference).unwrap(), error(&cov.image, &reference).unwrap());
+    assert!(ec.relmse < 0.5 * eu.relmse, "cov-filter {} vs uniform {}", ec.relmse, eu.relmse);
+}

@@ -1,0 +1,77 @@
+//! `covtrace render-bench`: a tiny run writes every output with finite numbers, caches
+//! its reference, and bad arguments give one line and exit code 2 before any work.
+
+mod common;
+use common::covtrace;
+
+#[test]
+fn a_tiny_bench_writes_every_output_and_caches_its_reference() {
+    let dir = common::tmp("bench", "out");
+    let d = dir.to_str().expect("utf-8 path");
+    let args = [
+        "render-bench",
+        "examples/scenes/cornell.ron",
+        "--size",
+        "32x24",
+        "--ref-spp",
+        "16",
+        "--budgets",
+        "2,4",
+        "-o",
+        d,
+    ];
+    let out = covtrace(&args);
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    for f in [
+        "results.csv",
+        "results.json",
+        "error_time.png",
+        "error_time.svg",
+        "strip.png",
+        "reference.png",
+        "cov.png",
+        "cov.error.png",
+    ] {
+        let len = std::fs::metadata(dir.join(f)).map(|m| m.len()).unwrap_or(0);
+        assert!(len > 0, "{f} missing or empty");
+    }
+    let csv = std::fs::read_to_string(dir.join("results.csv")).unwrap();
+    let rows: Vec<&str> = csv.lines().skip(1).collect();
+    assert_eq!(rows.len(), 2 * 6, "{csv}");
+    for r in &rows {
+        let cells: Vec<&str> = r.split(',').collect();
+        for c in &cells[1..10] {
+            let v: f64 = c.parse().unwrap_or_else(|_| panic!("{r}: `{c}` is not a number"));
+            assert!(v.is_finite() && v >= 0.0, "{r}");
+        }
+    }
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("results.json")).unwrap()).unwrap();
+    assert_eq!(json["runs"].as_array().map(Vec::len), Some(12));
+    assert!(!stdout.contains("NaN") && !stdout.contains("(cached)"), "{stdout}");
+    // The second run finds the reference in the cache.
+    let again = covtrace(&args);
+    assert!(again.status.success());
+    assert!(String::from_utf8_lossy(&again.stdout).contains("(cached)"));
+}
+
+#[test]
+fn bad_arguments_give_one_line() {
+    let cases: [(&[&str], &str); 6] = [
+        (&["--budgets", "0"], "--budgets: each must be 1 to 65536"),
+        (&["--budgets", "nan"], "--budgets: each must be 1 to 65536"),
+        (&["--methods", "cov,magic"], "unknown method `magic`"),
+        (&["--cov-stride", "3"], "--cov-stride must be one of"),
+        (&["--ref-spp", "0"], "--ref-spp must be 1 to 65536"),
+        (&["--budgets", "1,2,3,4,5,6,7,8,9,10,11,12,13"], "give 1 to 12 values"),
+    ];
+    for (extra, want) in cases {
+        let mut args = vec!["render-bench", "examples/scenes/cornell.ron", "-o", "/nonexistent/out"];
+        args.extend_from_slice(extra);
+        let out = covtrace(&args);
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{extra:?}: {stderr}");
+        assert!(stderr.contains(want) && stderr.trim().lines().count() == 1, "{extra:?}: {stderr}");
+    }
+}
