@@ -12,7 +12,9 @@ use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
 use cov_render::bench::{Guide, Method, Run, error, fit_loglog, run, speedup};
-use cov_render::render::{STRIDES, covariance_maps_strided, read_image, render_adaptive, tile_count, timed, tonemap, write_image};
+use cov_render::render::{
+    STRIDES, covariance_maps_strided, read_image, render_adaptive, tile_count, timed, tonemap, write_image,
+};
 use cov_render::{MAX_COV_PATHS, MAX_SPP, World};
 use plotters::coord::Shift;
 use plotters::prelude::*;
@@ -152,7 +154,9 @@ fn check_args(a: &BenchArgs) -> Result<(Vec<Method>, Vec<f64>), String> {
     }
     for &b in &a.budgets {
         if !(b.is_finite() && (1.0..=f64::from(MAX_SPP)).contains(&b)) {
-            return Err(format!("--budgets: each must be 1 to {MAX_SPP} samples per pixel, got {b}"));
+            return Err(format!(
+                "--budgets: each must be 1 to {MAX_SPP} samples per pixel, got {b}"
+            ));
         }
     }
     if a.ref_spp == 0 || a.ref_spp > MAX_SPP {
@@ -168,7 +172,10 @@ fn check_args(a: &BenchArgs) -> Result<(Vec<Method>, Vec<f64>), String> {
         return Err(format!("--repeat must be 1 to 10, got {}", a.repeat));
     }
     if !STRIDES.contains(&a.cov_stride) {
-        return Err(format!("--cov-stride must be one of {STRIDES:?}, got {}", a.cov_stride));
+        return Err(format!(
+            "--cov-stride must be one of {STRIDES:?}, got {}",
+            a.cov_stride
+        ));
     }
     let mut budgets = a.budgets.clone();
     budgets.sort_by(f64::total_cmp);
@@ -185,7 +192,12 @@ fn folder(dir: &Path, what: &str) -> Result<(), String> {
 }
 
 /// The reference image: from the cache when there, else rendered and cached.
-fn reference(a: &BenchArgs, world: &World, text: &[u8], cache: &Path) -> Result<(cov_render::Image, String), String> {
+fn reference(
+    a: &BenchArgs,
+    world: &World,
+    text: &[u8],
+    cache: &Path,
+) -> Result<(cov_render::Image, String), String> {
     let (w, h) = (world.camera.width, world.camera.height);
     let key = fnv(
         format!("covtrace-reference-v1 {w}x{h} {} {}", a.ref_spp, a.seed).as_bytes(),
@@ -212,7 +224,11 @@ fn reference(a: &BenchArgs, world: &World, text: &[u8], cache: &Path) -> Result<
     write_image(&img, &exr, &exr.with_extension("png"))?;
     Ok((
         img,
-        format!("reference: {} spp in {secs:.1} s, cached as {}", a.ref_spp, exr.display()),
+        format!(
+            "reference: {} spp in {secs:.1} s, cached as {}",
+            a.ref_spp,
+            exr.display()
+        ),
     ))
 }
 
@@ -247,7 +263,9 @@ pub fn bench(a: &BenchArgs) -> Result<String, String> {
         let mut best: Option<Guide> = None;
         for _ in 0..a.repeat {
             let b = bar(tile_count(&world), "covariance");
-            let (maps, secs) = timed(|| covariance_maps_strided(&world, a.cov_paths, a.cov_stride, a.seed, Some(&|| b.inc(1))));
+            let (maps, secs) = timed(|| {
+                covariance_maps_strided(&world, a.cov_paths, a.cov_stride, a.seed, Some(&|| b.inc(1)))
+            });
             b.finish_and_clear();
             let g = Guide::new(&maps?, secs);
             if best.as_ref().is_none_or(|b| g.secs < b.secs) {
@@ -303,16 +321,26 @@ pub fn bench(a: &BenchArgs) -> Result<String, String> {
     for r in &mut rows {
         r.speedup = speedup(&uniform, r.seconds, r.relmse);
     }
-    write_results(&a.output, &rows, &uniform)?;
+    write_results(&a.output, &rows, &uniform, at_error(&rows, &methods))?;
     let chart = a.output.join("error_time.png");
     let title = format!(
         "{}: relMSE against wall-clock time ({w}×{h} px, 2-core CPU)",
-        a.scene.file_name().map_or_else(String::new, |s| s.to_string_lossy().into_owned())
+        a.scene
+            .file_name()
+            .map_or_else(String::new, |s| s.to_string_lossy().into_owned())
     );
     for ext in ["png", "svg"] {
         let p = chart.with_extension(ext);
-        crate::plot::save(&p, (1100, 560), &ErrorChart { rows: &rows, methods: &methods, title: &title })
-            .map_err(|e| format!("{}: {e}", p.display()))?;
+        crate::plot::save(
+            &p,
+            (1100, 560),
+            &ErrorChart {
+                rows: &rows,
+                methods: &methods,
+                title: &title,
+            },
+        )
+        .map_err(|e| format!("{}: {e}", p.display()))?;
     }
     let strip = a.output.join("strip.png");
     let (target, picked) = write_strip(&strip, &images, &rows, &reference)?;
@@ -333,7 +361,9 @@ pub fn bench(a: &BenchArgs) -> Result<String, String> {
 /// The table printed at the end: relMSE per method and budget, the median equal-error
 /// speed-up, and the covariance share of time.
 fn summary(rows: &[Row], methods: &[Method], budgets: &[f64]) -> String {
-    let mut s = String::from("\nrelMSE (seconds) per budget; equal-error speed-up over uniform (median over budgets)\n");
+    let mut s = String::from(
+        "\nrelMSE (seconds) per budget; equal-error speed-up over uniform (median over budgets)\n",
+    );
     let _ = write!(s, "{:<12}", "method");
     for b in budgets {
         let _ = write!(s, "{:>20}", format!("{b} spp"));
@@ -347,14 +377,65 @@ fn summary(rows: &[Row], methods: &[Method], budgets: &[f64]) -> String {
         }
         let mut sp: Vec<f64> = mine.iter().filter_map(|r| r.speedup).collect();
         sp.sort_by(f64::total_cmp);
-        let med = if sp.is_empty() { "n/a".to_string() } else { format!("{:.2}×", sp[sp.len() / 2]) };
-        let share: f64 = mine.iter().map(|r| r.covariance_s / r.seconds.max(1e-12)).sum::<f64>() / mine.len().max(1) as f64;
+        let med = if sp.is_empty() {
+            "n/a".to_string()
+        } else {
+            format!("{:.2}×", sp[sp.len() / 2])
+        };
+        let share: f64 = mine
+            .iter()
+            .map(|r| r.covariance_s / r.seconds.max(1e-12))
+            .sum::<f64>()
+            / mine.len().max(1) as f64;
         let _ = writeln!(s, "{med:>10}{:>11.1}%", 100.0 * share);
+    }
+    if let Some((target, times)) = at_error(rows, methods) {
+        let _ = writeln!(
+            s,
+            "\nat relMSE {target:.3e} (uniform's error at its largest budget): seconds to reach it, and the speed-up over uniform"
+        );
+        let base = times.iter().find(|(m, _)| *m == "uniform").and_then(|(_, t)| *t);
+        for (m, t) in &times {
+            let _ = match (t, base) {
+                (Some((t, exact)), Some((b, _))) => {
+                    let ge = if *exact { "" } else { "≥ " };
+                    writeln!(s, "{m:<12}{t:>10.3} s{:>12}", format!("{ge}{:.2}×", b / t))
+                }
+                _ => writeln!(s, "{m:<12}{:>12}", "not reached"),
+            };
+        }
+        let _ = writeln!(s, "(≥: the method's smallest budget is already below that error)");
     }
     s
 }
 
-fn write_results(dir: &Path, rows: &[Row], uniform: &[(f64, f64)]) -> Result<(), String> {
+/// The error uniform Monte Carlo reaches at its largest budget, and the time each method
+/// needs to reach it ([`cov_render::bench::time_to_reach`]).
+fn at_error(rows: &[Row], methods: &[Method]) -> AtError {
+    let target = rows
+        .iter()
+        .filter(|r| r.method == "uniform")
+        .max_by(|a, b| a.budget.total_cmp(&b.budget))?
+        .relmse;
+    let times = methods
+        .iter()
+        .map(|m| {
+            let curve: Vec<(f64, f64)> = rows
+                .iter()
+                .filter(|r| r.method == m.name())
+                .map(|r| (r.seconds, r.relmse))
+                .collect();
+            (m.name(), cov_render::bench::time_to_reach(&curve, target))
+        })
+        .collect();
+    Some((target, times))
+}
+
+/// What [`at_error`] gives: the target error and each method's time to reach it (and
+/// whether interpolated).
+type AtError = Option<(f64, Vec<(&'static str, Option<(f64, bool)>)>)>;
+
+fn write_results(dir: &Path, rows: &[Row], uniform: &[(f64, f64)], at: AtError) -> Result<(), String> {
     let mut csv = String::from(
         "method,budget_spp,samples,seconds,covariance_s,sampling_s,reconstruction_s,allocation_s,rmse,relmse,speedup_vs_uniform\n",
     );
@@ -381,11 +462,30 @@ fn write_results(dir: &Path, rows: &[Row], uniform: &[(f64, f64)]) -> Result<(),
     let json = serde_json::json!({
         "units": { "seconds": "wall-clock s", "relmse": "mean over pixels and channels of (I-R)^2/(R^2+0.01)" },
         "uniform_fit": fit,
+        "at_uniform_best_error": at.map(|(e, times)| serde_json::json!({
+            "relmse": e,
+            // Per method: seconds to reach the error, and whether interpolated (false: the
+            // method's smallest budget is already below it, so the time is an upper bound).
+            "methods": times.into_iter().map(|(m, t)| (m.to_string(), serde_json::json!(t.map(|(s, i)| serde_json::json!({ "seconds": s, "interpolated": i }))))).collect::<serde_json::Map<_, _>>(),
+        })),
         "runs": rows,
     });
     let p = dir.join("results.json");
-    std::fs::write(&p, serde_json::to_string_pretty(&json).map_err(|e| e.to_string())?)
-        .map_err(|e| format!("{}: {e}", p.display()))
+    std::fs::write(
+        &p,
+        serde_json::to_string_pretty(&json).map_err(|e| e.to_string())?,
+    )
+    .map_err(|e| format!("{}: {e}", p.display()))
+}
+
+/// Log-axis tick labels at 1, 2 and 5 of each decade only (the other grid lines unlabelled).
+fn sparse_log_tick(v: &f64) -> String {
+    let m = *v / 10f64.powf(v.log10().floor());
+    if [1.0, 2.0, 5.0].iter().any(|k| (m - k).abs() < 1e-6 * k) {
+        log_tick(v)
+    } else {
+        String::new()
+    }
 }
 
 /// The log–log chart of relMSE against seconds, a line per method.
@@ -422,8 +522,8 @@ impl Picture for ErrorChart<'_> {
             .build_cartesian_2d((t0 / 1.5..t1 * 1.5).log_scale(), (e0 / 1.5..e1 * 1.5).log_scale())?;
         chart
             .configure_mesh()
-            .x_label_formatter(&log_tick)
-            .y_label_formatter(&log_tick)
+            .x_label_formatter(&sparse_log_tick)
+            .y_label_formatter(&sparse_log_tick)
             .x_desc("wall-clock time [s] (covariance pass included)")
             .y_desc("relMSE against the reference")
             .label_style(("sans-serif", 13))
@@ -444,7 +544,10 @@ impl Picture for ErrorChart<'_> {
             chart.draw_series(LineSeries::new(pts.iter().copied(), color.stroke_width(width)))?;
             chart.draw_series(pts.iter().map(|&p| Circle::new(p, 4, color.filled())))?;
             let y = 70 + 24 * i as i32;
-            right.draw(&PathElement::new(vec![(6, y), (34, y)], color.stroke_width(width)))?;
+            right.draw(&PathElement::new(
+                vec![(6, y), (34, y)],
+                color.stroke_width(width),
+            ))?;
             right.draw(&Circle::new((20, y), 4, color.filled()))?;
             right.draw(&Text::new(m.name(), (42, y - 8), font.clone()))?;
         }
@@ -455,7 +558,8 @@ impl Picture for ErrorChart<'_> {
 
 /// Writes the equal-time strip: for each method the run nearest (in log time) to uniform
 /// Monte Carlo's time at the middle budget, beside the reference, each labelled with
-/// method, spp, seconds and relMSE. Returns the target time and what was picked.
+/// method, spp, seconds and relMSE, above the centre quarter of each enlarged 4×.
+/// Returns the target time and what was picked.
 fn write_strip(
     path: &Path,
     images: &[(Method, f64, f64, cov_render::Image)],
@@ -504,10 +608,10 @@ fn write_strip(
     let (iw, ih) = (reference.width * scale, reference.height * scale);
     let gap = 6u32;
     let band = 40u32;
-    let (w, h) = (
-        panels.len() as u32 * (iw + gap) + gap,
-        ih + band + gap,
-    );
+    // A second row: the centre quarter of each image, enlarged 4× (nearest pixel).
+    let (cw, ch) = ((reference.width / 4).max(1), (reference.height / 4).max(1));
+    let (cx, cy) = ((reference.width - cw) / 2, (reference.height - ch) / 2);
+    let (w, h) = (panels.len() as u32 * (iw + gap) + gap, 2 * ih + band + 2 * gap);
     crate::plot::register_font()?;
     let mut buf = vec![255u8; w as usize * h as usize * 3];
     {
@@ -515,15 +619,31 @@ fn write_strip(
         let font = ("sans-serif", 13).into_font().color(&BLACK);
         for (k, (a, b, _)) in panels.iter().enumerate() {
             let x = (gap + k as u32 * (iw + gap)) as i32;
-            root.draw(&Text::new(a.as_str(), (x, 4), font.clone())).map_err(|e| e.to_string())?;
-            root.draw(&Text::new(b.as_str(), (x, 21), font.clone())).map_err(|e| e.to_string())?;
+            root.draw(&Text::new(a.as_str(), (x, 4), font.clone()))
+                .map_err(|e| e.to_string())?;
+            root.draw(&Text::new(b.as_str(), (x, 21), font.clone()))
+                .map_err(|e| e.to_string())?;
         }
         root.present().map_err(|e| e.to_string())?;
     }
     let mut pic = image::RgbImage::from_raw(w, h, buf).ok_or("strip buffer size")?;
     for (k, (_, _, img)) in panels.iter().enumerate() {
-        let t = image::imageops::resize(&tonemap(img), iw, ih, image::imageops::FilterType::Nearest);
-        image::imageops::replace(&mut pic, &t, i64::from(gap + k as u32 * (iw + gap)), i64::from(band));
+        let full = tonemap(img);
+        let zoom = image::imageops::crop_imm(&full, cx, cy, cw, ch).to_image();
+        let zoom = image::imageops::resize(&zoom, iw, ih, image::imageops::FilterType::Nearest);
+        image::imageops::replace(
+            &mut pic,
+            &zoom,
+            i64::from(gap + k as u32 * (iw + gap)),
+            i64::from(band + ih + gap),
+        );
+        let t = image::imageops::resize(&full, iw, ih, image::imageops::FilterType::Nearest);
+        image::imageops::replace(
+            &mut pic,
+            &t,
+            i64::from(gap + k as u32 * (iw + gap)),
+            i64::from(band),
+        );
     }
     pic.save(path).map_err(|e| format!("{}: {e}", path.display()))?;
     Ok((target, picked.join(", ")))

@@ -43,7 +43,10 @@ pub trait Picture {
     ///
     /// # Errors
     /// What the backend reports.
-    fn draw<DB: DrawingBackend>(&self, root: DrawingArea<DB, Shift>) -> Result<(), Box<dyn std::error::Error>>
+    fn draw<DB: DrawingBackend>(
+        &self,
+        root: DrawingArea<DB, Shift>,
+    ) -> Result<(), Box<dyn std::error::Error>>
     where
         DB::ErrorType: 'static;
 }
@@ -53,7 +56,11 @@ pub trait Picture {
 ///
 /// # Errors
 /// The file cannot be written.
-pub fn save<P: Picture>(path: &std::path::Path, size: (u32, u32), pic: &P) -> Result<(), Box<dyn std::error::Error>> {
+pub fn save<P: Picture>(
+    path: &std::path::Path,
+    size: (u32, u32),
+    pic: &P,
+) -> Result<(), Box<dyn std::error::Error>> {
     register_font()?;
     let (w, h) = size;
     if path.extension().is_some_and(|e| e == "svg") {

@@ -222,7 +222,10 @@ type Series = (&'static str, bool, f64, Vec<(f64, f64)>);
 struct ValidateChart<'a>(&'a [Series]);
 
 impl crate::plot::Picture for ValidateChart<'_> {
-    fn draw<DB: DrawingBackend>(&self, root: DrawingArea<DB, plotters::coord::Shift>) -> Result<(), Box<dyn std::error::Error>>
+    fn draw<DB: DrawingBackend>(
+        &self,
+        root: DrawingArea<DB, plotters::coord::Shift>,
+    ) -> Result<(), Box<dyn std::error::Error>>
     where
         DB::ErrorType: 'static,
     {

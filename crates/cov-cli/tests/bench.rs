@@ -49,7 +49,10 @@ fn a_tiny_bench_writes_every_output_and_caches_its_reference() {
     let json: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(dir.join("results.json")).unwrap()).unwrap();
     assert_eq!(json["runs"].as_array().map(Vec::len), Some(12));
-    assert!(!stdout.contains("NaN") && !stdout.contains("(cached)"), "{stdout}");
+    assert!(
+        !stdout.contains("NaN") && !stdout.contains("(cached)"),
+        "{stdout}"
+    );
     // The second run finds the reference in the cache.
     let again = covtrace(&args);
     assert!(again.status.success());
@@ -64,14 +67,25 @@ fn bad_arguments_give_one_line() {
         (&["--methods", "cov,magic"], "unknown method `magic`"),
         (&["--cov-stride", "3"], "--cov-stride must be one of"),
         (&["--ref-spp", "0"], "--ref-spp must be 1 to 65536"),
-        (&["--budgets", "1,2,3,4,5,6,7,8,9,10,11,12,13"], "give 1 to 12 values"),
+        (
+            &["--budgets", "1,2,3,4,5,6,7,8,9,10,11,12,13"],
+            "give 1 to 12 values",
+        ),
     ];
     for (extra, want) in cases {
-        let mut args = vec!["render-bench", "examples/scenes/cornell.ron", "-o", "/nonexistent/out"];
+        let mut args = vec![
+            "render-bench",
+            "examples/scenes/cornell.ron",
+            "-o",
+            "/nonexistent/out",
+        ];
         args.extend_from_slice(extra);
         let out = covtrace(&args);
         let stderr = String::from_utf8_lossy(&out.stderr);
         assert_eq!(out.status.code(), Some(2), "{extra:?}: {stderr}");
-        assert!(stderr.contains(want) && stderr.trim().lines().count() == 1, "{extra:?}: {stderr}");
+        assert!(
+            stderr.contains(want) && stderr.trim().lines().count() == 1,
+            "{extra:?}: {stderr}"
+        );
     }
 }

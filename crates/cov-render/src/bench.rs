@@ -382,7 +382,12 @@ pub fn run(
         Method::CovDensity | Method::Cov => {
             let t = Instant::now();
             let lo = ((budget / 4.0).floor() as u32).max(1);
-            let counts = allocate(&guide.map(|g| g.density.clone()).unwrap_or_default(), total, lo, hi);
+            let counts = allocate(
+                &guide.map(|g| g.density.clone()).unwrap_or_default(),
+                total,
+                lo,
+                hi,
+            );
             timing.allocation = t.elapsed().as_secs_f64();
             timing.sample(|| film.render(world, &counts, seed, f64::INFINITY, progress));
         }
@@ -535,6 +540,36 @@ pub fn fit_loglog(points: &[(f64, f64)]) -> Option<(f64, f64)> {
     Some((my - b * mx, b))
 }
 
+/// The time a curve of `(seconds, error)` points needs to reach error `e`, interpolated
+/// linearly in log–log between the two points around it (the curve ordered by time), and
+/// whether it was interpolated: a curve whose first point is already below `e` gives that
+/// point's time and `false` (an upper bound). `None` when the curve never reaches `e`.
+pub fn time_to_reach(curve: &[(f64, f64)], e: f64) -> Option<(f64, bool)> {
+    let mut p: Vec<(f64, f64)> = curve
+        .iter()
+        .copied()
+        .filter(|(t, v)| *t > 0.0 && *v > 0.0 && t.is_finite() && v.is_finite())
+        .collect();
+    p.sort_by(|a, b| a.0.total_cmp(&b.0));
+    if !(e > 0.0) {
+        return None;
+    }
+    if let Some(first) = p.first()
+        && first.1 <= e
+    {
+        return Some((first.0, false));
+    }
+    p.windows(2).find_map(|w| {
+        let ((t0, e0), (t1, e1)) = (w[0], w[1]);
+        if e0 > e && e1 <= e {
+            let f = (e.ln() - e0.ln()) / (e1.ln() - e0.ln());
+            Some(((t0.ln() + f * (t1.ln() - t0.ln())).exp(), true))
+        } else {
+            None
+        }
+    })
+}
+
 /// The equal-error speed-up of a run `(t, e)` over a baseline curve: the time the
 /// baseline's log–log fit needs to reach error `e`, divided by `t`. `None` when the
 /// baseline's error does not fall with time.
@@ -572,6 +607,16 @@ mod tests {
     }
 
     #[test]
+    fn time_to_reach_interpolates_in_log_log() {
+        let c = [(1.0, 1.0), (4.0, 0.25), (16.0, 0.0625)];
+        let (t, exact) = time_to_reach(&c, 0.5).unwrap();
+        assert!((t - 2.0).abs() < 1e-12 && exact);
+        assert_eq!(time_to_reach(&c, 2.0), Some((1.0, false)));
+        assert_eq!(time_to_reach(&c, 0.01), None);
+        assert_eq!(time_to_reach(&c, f64::NAN), None);
+    }
+
+    #[test]
     fn speedup_reads_the_baseline_fit() {
         // Error ∝ 1/t: the baseline reaches e = 0.01 at t = 100.
         let base: Vec<(f64, f64)> = [1.0, 2.0, 4.0, 8.0].iter().map(|&t| (t, 1.0 / t)).collect();
@@ -589,7 +634,13 @@ mod tests {
             height: 1,
             pixels: vec![glam::DVec3::splat(1.0), glam::DVec3::splat(0.0)],
         };
-        assert_eq!(error(&r, &r).unwrap(), Error { rmse: 0.0, relmse: 0.0 });
+        assert_eq!(
+            error(&r, &r).unwrap(),
+            Error {
+                rmse: 0.0,
+                relmse: 0.0
+            }
+        );
         let mut a = r.clone();
         a.pixels[1] = glam::DVec3::splat(0.1);
         let e = error(&a, &r).unwrap();

@@ -377,7 +377,11 @@ impl Film {
                     let (jx, jy, lu, lv, ut) = (s.next(), s.next(), s.next(), s.next(), s.next());
                     let ray = world.camera.ray(x as f64 + jx, y as f64 + jy, (lu, lv), ut);
                     let (e, r) = radiance_parts(world, &ray, s);
-                    let (e, r) = if (e + r).is_finite() { (e, r) } else { (DVec3::ZERO, DVec3::ZERO) };
+                    let (e, r) = if (e + r).is_finite() {
+                        (e, r)
+                    } else {
+                        (DVec3::ZERO, DVec3::ZERO)
+                    };
                     let yl = luminance(e + r);
                     let (e, r) = if yl > max_luminance {
                         let k = max_luminance / yl;
@@ -404,7 +408,12 @@ mod tests {
 
     #[test]
     fn gaussians_are_normalised_and_clamped() {
-        for c in [[4.0, 1.0, 2.0], [1.0, 0.0, 9.0], [0.01, 0.0, 0.01], [1e9, 0.0, 1.0]] {
+        for c in [
+            [4.0, 1.0, 2.0],
+            [1.0, 0.0, 9.0],
+            [0.01, 0.0, 0.01],
+            [1e9, 0.0, 1.0],
+        ] {
             let g = Gaussian::from_cov(c);
             // ∑ over a fine grid ≈ 1.
             let h = 0.05;
@@ -427,7 +436,12 @@ mod tests {
     /// The row walk gives the weights `weight` gives, cell by cell, and no others.
     #[test]
     fn row_walk_matches_the_weights() {
-        for c in [[4.0, 1.5, 2.0], [9.0, -2.9, 1.0], [0.09, 0.0, 0.09], [200.0, 0.0, 0.2]] {
+        for c in [
+            [4.0, 1.5, 2.0],
+            [9.0, -2.9, 1.0],
+            [0.09, 0.0, 0.09],
+            [200.0, 0.0, 0.2],
+        ] {
             let g = Gaussian::from_cov(c);
             let r = (CUTOFF * g.std_max()).ceil() as usize;
             for x in [0usize, 3, r, 40] {
@@ -436,8 +450,15 @@ mod tests {
                     g.splat_row(&mut row, x, dy as f64, r, |e, w| *e += w);
                     for (k, v) in row.iter().enumerate() {
                         let dx = k as f64 - x as f64;
-                        let want = if dx.abs() <= r as f64 { g.weight(dx, dy as f64) } else { 0.0 };
-                        assert!((v - want).abs() <= 1e-12 * g.norm, "{c:?} x {x} dy {dy} cell {k}: {v} vs {want}");
+                        let want = if dx.abs() <= r as f64 {
+                            g.weight(dx, dy as f64)
+                        } else {
+                            0.0
+                        };
+                        assert!(
+                            (v - want).abs() <= 1e-12 * g.norm,
+                            "{c:?} x {x} dy {dy} cell {k}: {v} vs {want}"
+                        );
                     }
                 }
             }

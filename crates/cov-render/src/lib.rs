@@ -19,8 +19,18 @@
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
 //!
-//! Determinism: tiles draw from generators seeded by the scene seed and the tile index,
-//! so an image is the same on any number of threads.
+//! Rendering with the covariance pass ([`bench`]): samples are allocated to pixels in
+//! proportion to the predicted density, and each pixel's samples are reconstructed by a
+//! Gaussian filter made from its image-space Σ ([`film`]), scaled per pixel to balance the
+//! bias the spectrum predicts against the noise of the samples it averages. The baselines a
+//! user would pick without covariance tracing (uniform sampling with a box or a fixed
+//! Gaussian filter, two-pass variance-driven sampling) run through the same film, and
+//! `covtrace render-bench` measures image error against wall-clock time for all of them.
+//!
+//! Determinism: pixels draw from their own Owen-scrambled Sobol sequences ([`sampler`])
+//! and the covariance pass's tiles from generators seeded by the scene seed and the tile
+//! index; results are added in a fixed order, so an image is the same on any number of
+//! threads.
 
 #![warn(missing_docs)]
 

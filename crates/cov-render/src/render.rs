@@ -193,7 +193,9 @@ pub fn covariance_maps_strided(
     progress: Progress<'_>,
 ) -> Result<CovMaps, String> {
     if !STRIDES.contains(&stride) {
-        return Err(format!("the covariance grid's stride must be one of {STRIDES:?}, got {stride}"));
+        return Err(format!(
+            "the covariance grid's stride must be one of {STRIDES:?}, got {stride}"
+        ));
     }
     let paths = paths.clamp(1, MAX_COV_PATHS);
     let cc = CovCamera::new(world).map_err(|e| e.to_string())?;
@@ -321,7 +323,9 @@ pub fn write_image(img: &Image, exr: &Path, png: &Path) -> Result<(), String> {
         .collect();
     let hdr = image::Rgb32FImage::from_raw(img.width, img.height, raw).ok_or("image size")?;
     hdr.save(exr).map_err(|e| format!("{}: {e}", exr.display()))?;
-    tonemap(img).save(png).map_err(|e| format!("{}: {e}", png.display()))
+    tonemap(img)
+        .save(png)
+        .map_err(|e| format!("{}: {e}", png.display()))
 }
 
 /// Reads a linear RGB image (an EXR written by [`write_image`]).

@@ -103,7 +103,10 @@ mod tests {
                 lens[cell(v[2], v[3])] += 1;
             }
             assert!(pix.iter().all(|&c| c == 1), "{n} samples over the pixel: {pix:?}");
-            assert!(lens.iter().all(|&c| c == 1), "{n} samples over the lens: {lens:?}");
+            assert!(
+                lens.iter().all(|&c| c == 1),
+                "{n} samples over the lens: {lens:?}"
+            );
         }
     }
 

@@ -5,8 +5,8 @@
 //! The estimator is unbiased for the transport it includes: paths of one and two bounces
 //! (camera → x₁ → light, camera → x₁ → x₂ → light) and lights seen directly.
 
-use glam::DVec3;
 use crate::sampler::Sampler;
+use glam::DVec3;
 
 use crate::geometry::Hit;
 use crate::world::{CameraRay, World};

@@ -26,7 +26,10 @@ fn filters_agree_with_the_box_on_a_flat_image() {
     a.render(&world, &counts, 1, f64::INFINITY, None);
     let mut b = Film::new(16, 12);
     b.render(&world, &counts, 1, f64::INFINITY, None);
-    let (ia, ib) = (a.image(&Filter::Box), b.image(&Filter::Fixed(Gaussian::isotropic(1.0))));
+    let (ia, ib) = (
+        a.image(&Filter::Box),
+        b.image(&Filter::Fixed(Gaussian::isotropic(1.0))),
+    );
     for (k, (p, q)) in ia.pixels.iter().zip(&ib.pixels).enumerate() {
         assert!((p.y - q.y).abs() < 0.05 * p.y, "pixel {k}: box {p}, gauss {q}");
     }
@@ -46,11 +49,22 @@ fn reconstruction_keeps_a_constant_under_any_filters() {
         film.count[i] = n;
         film.reflected[i] = c * f64::from(n);
         let a = 0.05 + (i % 11) as f64;
-        filters.push(Gaussian::from_cov([a, 0.3 * a * ((i % 3) as f64 - 1.0), 1.0 + (i % 5) as f64]));
+        filters.push(Gaussian::from_cov([
+            a,
+            0.3 * a * ((i % 3) as f64 - 1.0),
+            1.0 + (i % 5) as f64,
+        ]));
     }
-    for f in [Filter::Box, Filter::Fixed(Gaussian::isotropic(2.0)), Filter::PerPixel(filters)] {
+    for f in [
+        Filter::Box,
+        Filter::Fixed(Gaussian::isotropic(2.0)),
+        Filter::PerPixel(filters),
+    ] {
         for p in film.image(&f).pixels {
-            assert!((p - c).abs().max_element() <= 1e-12 * c.max_element(), "{f:?}: {p}");
+            assert!(
+                (p - c).abs().max_element() <= 1e-12 * c.max_element(),
+                "{f:?}: {p}"
+            );
         }
     }
 }
@@ -74,12 +88,19 @@ fn a_two_pass_estimate_matches_the_closed_form() {
     let got = film.box_image().pixels[0].y;
     let exact = 0.5 * (0.5f64 / 2.0).powi(2);
     let stderr = (film.variance()[0] / 12001.0).sqrt();
-    assert!(stderr > 0.0 && (got - exact).abs() <= 4.0 * stderr, "got {got}, closed form {exact} ± {stderr}");
+    assert!(
+        stderr > 0.0 && (got - exact).abs() <= 4.0 * stderr,
+        "got {got}, closed form {exact} ± {stderr}"
+    );
 }
 
 fn scene(name: &str, w: u32, h: u32) -> World {
-    let p = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/scenes").join(name);
-    World::load(&p).unwrap_or_else(|e| panic!("{e}")).with_resolution(w, h)
+    let p = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../examples/scenes")
+        .join(name);
+    World::load(&p)
+        .unwrap_or_else(|e| panic!("{e}"))
+        .with_resolution(w, h)
 }
 
 /// Every method runs on every bundled scene, spends its budget, and gives a finite,
@@ -97,16 +118,26 @@ fn every_method_runs_on_every_scene() {
         for m in Method::ALL {
             let r = run(&world, m, 6.0, Some(&guide), 1, None).unwrap();
             assert!(
-                r.image.pixels.iter().all(|p| p.is_finite() && p.min_element() >= 0.0),
+                r.image
+                    .pixels
+                    .iter()
+                    .all(|p| p.is_finite() && p.min_element() >= 0.0),
                 "{name} {m:?}"
             );
             // Rounding moves at most one sample per pixel.
-            assert!((r.samples as f64 - 6.0 * 24.0 * 16.0).abs() <= 24.0 * 16.0, "{name} {m:?}: {} samples", r.samples);
+            assert!(
+                (r.samples as f64 - 6.0 * 24.0 * 16.0).abs() <= 24.0 * 16.0,
+                "{name} {m:?}: {} samples",
+                r.samples
+            );
             let e = error(&r.image, &reference).unwrap();
             assert!(e.rmse.is_finite() && e.relmse.is_finite(), "{name} {m:?}");
             assert!(r.timing.total() > 0.0);
             if m.uses_covariance() {
-                assert!(run(&world, m, 6.0, None, 1, None).is_err(), "{m:?} without a guide");
+                assert!(
+                    run(&world, m, 6.0, None, 1, None).is_err(),
+                    "{m:?} without a guide"
+                );
             }
         }
     }
@@ -123,6 +154,14 @@ fn the_covariance_filter_lowers_the_error_of_a_noisy_image() {
     let guide = Guide::new(&covariance_maps_strided(&world, 1, 4, 1, None).unwrap(), 0.0);
     let uni = run(&world, Method::Uniform, 4.0, None, 1, None).unwrap();
     let cov = run(&world, Method::CovFilter, 4.0, Some(&guide), 1, None).unwrap();
-    let (eu, ec) = (error(&uni.image, &reference).unwrap(), error(&cov.image, &reference).unwrap());
-    assert!(ec.relmse < 0.5 * eu.relmse, "cov-filter {} vs uniform {}", ec.relmse, eu.relmse);
+    let (eu, ec) = (
+        error(&uni.image, &reference).unwrap(),
+        error(&cov.image, &reference).unwrap(),
+    );
+    assert!(
+        ec.relmse < 0.5 * eu.relmse,
+        "cov-filter {} vs uniform {}",
+        ec.relmse,
+        eu.relmse
+    );
 }

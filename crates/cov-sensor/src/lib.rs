@@ -397,9 +397,7 @@ impl Sensor {
         self.pixel_filter(c2.as_spectrum_mut())?;
         let image_axes = c2.as_spectrum_mut().spatial_axes();
         let n_img = r.image_dims;
-        let image_cov_px: Vec<Vec<f64>> = (0..n_img)
-            .map(|i| r.image_cov_px[i][..n_img].to_vec())
-            .collect();
+        let image_cov_px: Vec<Vec<f64>> = (0..n_img).map(|i| r.image_cov_px[i][..n_img].to_vec()).collect();
         let filter = scaled_block(&c2, image_axes, self.pitch)?
             .reconstruction_filter(&vec![self.p.max_filter; n_img])?;
         let mut sampled_axes: Vec<String> = image_axes.iter().map(|a| format!("{a}_px")).collect();
@@ -453,7 +451,9 @@ fn psd_det(k: usize, m: &mut [[f64; MAX]; MAX]) -> f64 {
     let mut order = [0, 1, 2, 3, 4];
     for s in 0..k {
         // Pivot: the largest remaining diagonal.
-        let p = (s..k).max_by(|&a, &b| m[order[a]][order[a]].total_cmp(&m[order[b]][order[b]])).unwrap_or(s);
+        let p = (s..k)
+            .max_by(|&a, &b| m[order[a]][order[a]].total_cmp(&m[order[b]][order[b]]))
+            .unwrap_or(s);
         order.swap(s, p);
         let d = m[order[s]][order[s]];
         if !(d > 0.0) {
@@ -592,7 +592,9 @@ mod tests {
     fn psd_det_matches_the_eigenvalues() {
         let mut seed = 12345u64;
         let mut next = || {
-            seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            seed = seed
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
             (seed >> 11) as f64 / (1u64 << 53) as f64 - 0.5
         };
         for k in 1..=5 {
@@ -608,7 +610,10 @@ mod tests {
                 let want: f64 = vals[..k].iter().map(|v| v.max(0.0)).product();
                 let got = psd_det(k, &mut m.clone());
                 let scale = (0..k).map(|i| m[i][i]).product::<f64>().max(1e-300);
-                assert!((got - want).abs() <= 1e-10 * scale, "k {k} rank {rank}: {got} vs {want}");
+                assert!(
+                    (got - want).abs() <= 1e-10 * scale,
+                    "k {k} rank {rank}: {got} vs {want}"
+                );
             }
         }
     }
