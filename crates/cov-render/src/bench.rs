@@ -551,7 +551,7 @@ pub fn time_to_reach(curve: &[(f64, f64)], e: f64) -> Option<(f64, bool)> {
         .filter(|(t, v)| *t > 0.0 && *v > 0.0 && t.is_finite() && v.is_finite())
         .collect();
     p.sort_by(|a, b| a.0.total_cmp(&b.0));
-    if !(e > 0.0) {
+    if e.is_nan() || e <= 0.0 {
         return None;
     }
     if let Some(first) = p.first()

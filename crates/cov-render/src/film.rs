@@ -248,7 +248,7 @@ impl Film {
         }
         let (w, h) = (self.width as usize, self.height as usize);
         // Each band of rows splats into a buffer with a margin as deep as its filters reach.
-        let bands: Vec<(usize, usize, Vec<(DVec3, f64)>)> = (0..h.div_ceil(BAND))
+        let bands: Vec<(usize, Vec<(DVec3, f64)>)> = (0..h.div_ceil(BAND))
             .into_par_iter()
             .map(|b| {
                 let (y0, y1) = (b * BAND, ((b + 1) * BAND).min(h));
@@ -278,11 +278,11 @@ impl Film {
                         }
                     }
                 }
-                (top, bottom, buf)
+                (top, buf)
             })
             .collect();
         let mut acc = vec![(DVec3::ZERO, 0.0); w * h];
-        for (top, _, buf) in bands {
+        for (top, buf) in bands {
             for (k, v) in buf.into_iter().enumerate() {
                 let e = &mut acc[top * w + k];
                 e.0 += v.0;

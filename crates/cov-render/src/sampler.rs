@@ -3,10 +3,11 @@
 //! adaptive sampling (any count per pixel) and a second pass (indices that continue the
 //! first) stay stratified.
 //!
-//! Dimensions are served in groups of four ("padding"): group `k` of pixel `p` is the
-//! first four dimensions of the sequence scrambled with its own seed `hash(seed, p, k)`.
-//! The first group is pixel x, pixel y, lens u, lens v; the second starts with time and
-//! the light choice. Groups are statistically independent of each other, stratified within.
+//! Dimensions are served in pairs ("padding"): pair `k` of pixel `p` is the first two
+//! dimensions of the sequence (a (0, 2)-sequence: every power-of-two prefix is stratified
+//! in 2D) scrambled with its own seed `hash(seed, p, k)`. The first pair is the position in
+//! the pixel, the second the lens, the third time and the light choice. Pairs are
+//! statistically independent of each other, stratified within.
 
 /// A source of the numbers in `[0, 1)` one sample consumes, dimension after dimension.
 pub trait Sampler {
@@ -17,10 +18,10 @@ pub trait Sampler {
 /// Largest sample index the sequence supports (`sobol_burley` has 2¹⁶ points).
 pub const MAX_INDEX: u32 = 1 << 16;
 
-/// Number of four-dimensional groups one sample may use: the path tracer uses at most 16
-/// dimensions; a sample that asks for more gets groups with wrapped seeds (still uniform,
-/// no longer independent of the first ones, which never happens with this tracer).
-const GROUPS: u32 = 64;
+/// Number of pairs one sample may use: the path tracer uses at most 16 dimensions; a
+/// sample that asks for more gets pairs with wrapped seeds (still uniform, no longer
+/// independent of the first ones, which never happens with this tracer).
+const PAIRS: u32 = 64;
 
 /// The padded Owen-scrambled Sobol sampler of one pixel.
 #[derive(Clone, Debug)]
@@ -28,7 +29,7 @@ pub struct SobolSampler {
     seed: u32,
     index: u32,
     dim: u32,
-    group: [f32; 4],
+    pair: [f32; 4],
 }
 
 /// A 32-bit mix (the finaliser of MurmurHash3): decorrelates nearby seeds.
@@ -50,7 +51,7 @@ impl SobolSampler {
             seed: s,
             index: 0,
             dim: 0,
-            group: [0.0; 4],
+            pair: [0.0; 4],
         }
     }
 
@@ -63,13 +64,13 @@ impl SobolSampler {
 
 impl Sampler for SobolSampler {
     fn next(&mut self) -> f64 {
-        let k = self.dim % 4;
+        let k = self.dim % 2;
         if k == 0 {
-            let g = (self.dim / 4) % GROUPS;
-            self.group = sobol_burley::sample_4d(self.index, 0, mix(self.seed ^ mix(g)));
+            let g = (self.dim / 2) % PAIRS;
+            self.pair = sobol_burley::sample_4d(self.index, 0, mix(self.seed ^ mix(g)));
         }
         self.dim += 1;
-        f64::from(self.group[k as usize])
+        f64::from(self.pair[k as usize])
     }
 }
 
@@ -120,7 +121,7 @@ mod tests {
         let va: Vec<f64> = (0..8).map(|_| a.next()).collect();
         let vb: Vec<f64> = (0..8).map(|_| b.next()).collect();
         assert_ne!(va, vb);
-        assert_ne!(va[..4], va[4..]);
+        assert_ne!(va[..2], va[2..4]);
         assert!(va.iter().chain(&vb).all(|v| (0.0..1.0).contains(v)));
     }
 }

@@ -456,7 +456,7 @@ fn psd_det(k: usize, m: &mut [[f64; MAX]; MAX]) -> f64 {
             .unwrap_or(s);
         order.swap(s, p);
         let d = m[order[s]][order[s]];
-        if !(d > 0.0) {
+        if d.is_nan() || d <= 0.0 {
             return 0.0;
         }
         det *= d;
