@@ -59,8 +59,8 @@ pub struct BenchArgs {
     /// Folder of cached references (default: the output folder).
     #[arg(long)]
     pub cache: Option<PathBuf>,
-    /// Times each run this many times and keeps the fastest (renders are deterministic:
-    /// only the time differs; 1 to 10).
+    /// Renders each run this many times with different seeds: errors are averaged, the
+    /// fastest time is kept (1 to 10).
     #[arg(long, default_value_t = 1)]
     pub repeat: u32,
 }
@@ -297,15 +297,22 @@ pub fn bench(a: &BenchArgs) -> Result<String, String> {
     let mut images: Vec<(Method, f64, f64, cov_render::Image)> = Vec::new();
     for &budget in &budgets {
         for &m in &methods {
-            let mut r = run(&world, m, budget, guide.as_ref(), a.seed, None)?;
-            for _ in 1..a.repeat {
-                let again = run(&world, m, budget, guide.as_ref(), a.seed, None)?;
-                if again.timing.total() < r.timing.total() {
-                    r = again;
+            // Repeats use other seeds: the errors are averaged (a low-spp image's error
+            // depends on where its rare bright paths fell), the fastest time is kept.
+            let first = run(&world, m, budget, guide.as_ref(), a.seed, None)?;
+            let mut row = Row::new(&first, &reference)?;
+            for k in 1..a.repeat {
+                let seed = a.seed.wrapping_add(u64::from(k) * 1_000_003);
+                let again = Row::new(&run(&world, m, budget, guide.as_ref(), seed, None)?, &reference)?;
+                row.rmse += again.rmse;
+                row.relmse += again.relmse;
+                if again.seconds < row.seconds {
+                    row = Row { rmse: row.rmse, relmse: row.relmse, ..again };
                 }
             }
-            let row = Row::new(&r, &reference)?;
-            images.push((m, budget, row.seconds, r.image));
+            row.rmse /= f64::from(a.repeat);
+            row.relmse /= f64::from(a.repeat);
+            images.push((m, budget, row.seconds, first.image));
             rows.push(row);
             b.inc(1);
         }
@@ -343,7 +350,7 @@ pub fn bench(a: &BenchArgs) -> Result<String, String> {
         .map_err(|e| format!("{}: {e}", p.display()))?;
     }
     let strip = a.output.join("strip.png");
-    let (target, picked) = write_strip(&strip, &images, &rows, &reference)?;
+    let (target, picked) = write_strip(&strip, &images, &reference)?;
     out.push_str(&summary(&rows, &methods, &budgets));
     let _ = writeln!(
         out,
@@ -563,7 +570,6 @@ impl Picture for ErrorChart<'_> {
 fn write_strip(
     path: &Path,
     images: &[(Method, f64, f64, cov_render::Image)],
-    rows: &[Row],
     reference: &cov_render::Image,
 ) -> Result<(f64, String), String> {
     let uni: Vec<&(Method, f64, f64, cov_render::Image)> =
@@ -583,10 +589,8 @@ fn write_strip(
             .filter(|i| i.0 == m)
             .min_by(|a, b| (a.2 / target).ln().abs().total_cmp(&(b.2 / target).ln().abs()));
         if let Some((m, budget, secs, img)) = best {
-            let rel = rows
-                .iter()
-                .find(|r| r.method == m.name() && r.budget == *budget)
-                .map_or(f64::NAN, |r| r.relmse);
+            // This image's own error (the table averages over repeats).
+            let rel = error(img, reference)?.relmse;
             panels.push((
                 format!("{} · {budget} spp · {secs:.2} s", m.name()),
                 format!("relMSE {rel:.2e}"),
