@@ -307,7 +307,11 @@ pub fn bench(a: &BenchArgs) -> Result<String, String> {
                 row.rmse += again.rmse;
                 row.relmse += again.relmse;
                 if again.seconds < row.seconds {
-                    row = Row { rmse: row.rmse, relmse: row.relmse, ..again };
+                    row = Row {
+                        rmse: row.rmse,
+                        relmse: row.relmse,
+                        ..again
+                    };
                 }
             }
             row.rmse /= f64::from(a.repeat);
