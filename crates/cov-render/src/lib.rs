@@ -19,7 +19,7 @@
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
 //!
-//! Rendering with the covariance pass ([`bench`]): samples are allocated to pixels in
+//! Rendering with the covariance pass ([`mod@bench`]): samples are allocated to pixels in
 //! proportion to the predicted density, and each pixel's samples are reconstructed by a
 //! Gaussian filter made from its image-space Σ ([`film`]), scaled per pixel to balance the
 //! bias the spectrum predicts against the noise of the samples it averages. The baselines a
