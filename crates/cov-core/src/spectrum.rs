@@ -336,6 +336,7 @@ pub fn transverse_pairs(n: usize) -> &'static [(Axis, Axis)] {
 }
 
 /// Reads a `k × k` row-major symmetric PSD block (a window or lobe spectrum).
+#[inline(always)]
 pub(crate) fn block_from_slice(op: &str, name: &str, k: usize, w: &[f64]) -> Result<Small, CovError> {
     if w.len() != k * k {
         return Err(CovError::Shape {
@@ -380,7 +381,7 @@ pub(crate) fn block_from_slice(op: &str, name: &str, k: usize, w: &[f64]) -> Res
 }
 
 /// The indices of `axes` in layout `n` (at most `n`, distinct), for kernel `op`.
-#[inline]
+#[inline(always)]
 pub(crate) fn resolve(n: usize, op: &str, axes: &[Axis]) -> Result<([usize; MAX], usize), CovError> {
     let mut idx = [0usize; MAX];
     if axes.is_empty() || axes.len() > n {
@@ -404,7 +405,7 @@ pub(crate) fn resolve(n: usize, op: &str, axes: &[Axis]) -> Result<([usize; MAX]
 }
 
 /// The indices of two different axes `a`, `b` of layout `n`, for kernel `op`.
-#[inline]
+#[inline(always)]
 pub(crate) fn two_axes(n: usize, op: &str, a: Axis, b: Axis) -> Result<(usize, usize), CovError> {
     let (i, j) = (axis_index(n, a)?, axis_index(n, b)?);
     if i == j {

@@ -304,6 +304,9 @@ impl<const N: usize> Spectrum for CovFactor<N> {
     /// A column `√w e_i` is appended and the factor folded back.
     #[inline]
     fn raw_add_variance(&mut self, op: &str, i: usize, w: f64) -> Result<(), CovError> {
+        if let Some(order) = self.triangular_order() {
+            return self.commit(op, self.rank_one_triangular(&order, i, w.sqrt()));
+        }
         let mut m = self.work();
         m[i][N] = w.sqrt();
         self.fold(op, m, N + 1)
@@ -342,6 +345,56 @@ impl<const N: usize> CovFactor<N> {
             l[i].copy_from_slice(&self.l[i][..M]);
         }
         Some(CovFactor { l })
+    }
+
+    /// A row order in which the factor is lower triangular (row `order[j]` has no entry
+    /// beyond column `j`), if there is one: every fold leaves the factor triangular and a
+    /// pivoted Cholesky factor is triangular in its pivot order.
+    #[inline]
+    fn triangular_order(&self) -> Option<[usize; N]> {
+        // Rows by their last non-zero column (−1 for a zero row), ascending.
+        let mut last = [0i64; N];
+        for (r, row) in self.l.iter().enumerate() {
+            last[r] = row.iter().rposition(|v| *v != 0.0).map_or(-1, |c| c as i64);
+        }
+        let mut order = [0usize; N];
+        for (j, o) in order.iter_mut().enumerate() {
+            *o = j;
+        }
+        order.sort_unstable_by_key(|&r| (last[r], r));
+        order
+            .iter()
+            .enumerate()
+            .all(|(j, &r)| last[r] <= j as i64)
+            .then_some(order)
+    }
+
+    /// `L'` with `L' L'ᵀ = L Lᵀ + x xᵀ` for `x = a e_i`, for a factor lower triangular in
+    /// the row order `order`: Givens rotations of column `k` with `x`, for `k` from the
+    /// position of row `i` on, each zeroing `x` at row `order[k]` (rows before it are zero
+    /// in both), so `L'` stays triangular in that order. The same orthogonal fold as
+    /// [`Self::fold`]'s reflections, in `O(N²)` instead of `O(N³)`; a zero column (a
+    /// rank-deficient Σ) takes `x` exactly (`c = 0, s = ±1`).
+    #[inline]
+    fn rank_one_triangular(&self, order: &[usize; N], i: usize, a: f64) -> [[f64; N]; N] {
+        let mut new = self.l;
+        let mut x = [0.0; N];
+        x[i] = a;
+        let start = order.iter().position(|&r| r == i).unwrap_or(0);
+        for k in start..N {
+            let (d, b) = (new[order[k]][k], x[order[k]]);
+            if b == 0.0 {
+                continue;
+            }
+            let r = d.hypot(b);
+            let (c, s) = (d / r, b / r);
+            for &row in &order[k..] {
+                let (lj, xj) = (new[row][k], x[row]);
+                new[row][k] = c * lj + s * xj;
+                x[row] = c * xj - s * lj;
+            }
+        }
+        new
     }
 
     /// The factor in a work array, columns `0..N`.
