@@ -292,6 +292,10 @@ impl Reflect {
         lobe: Lobe,
         turn: f64,
     ) -> Result<Self, CovError> {
+        // Checked here under the names the user wrote (the projections would name `cos`).
+        for (name, c) in [("cos_in", cos_in), ("cos_out", cos_out)] {
+            CovError::require_range(Self::NAME, name, c, |c| c > 0.0 && c <= 1.0, "must be in (0, 1]")?;
+        }
         Ok(Reflect {
             project: Project::new(cos_in)?,
             curvature,

@@ -67,3 +67,97 @@ fn the_largest_count_a_user_may_give_is_bounded_work() {
     // Not a timing test: a bound far above the measured few milliseconds, to catch a hang.
     assert!(t.elapsed().as_secs() < 60);
 }
+
+/// Every matrix `covtrace eval --json` prints (start, each step, result).
+fn matrices(json: &serde_json::Value) -> Vec<Vec<Vec<f64>>> {
+    let m = |v: &serde_json::Value| -> Vec<Vec<f64>> {
+        v.as_array()
+            .expect("rows")
+            .iter()
+            .map(|r| {
+                r.as_array()
+                    .expect("row")
+                    .iter()
+                    .map(|x| x.as_f64().expect("number"))
+                    .collect()
+            })
+            .collect()
+    };
+    let mut out = vec![m(&json["start"])];
+    for s in json["steps"].as_array().expect("steps") {
+        out.push(m(&s["matrix"]));
+    }
+    out.push(m(&json["result"]));
+    out
+}
+
+/// A ray refocused by a curved surface (travel 1/3, then curvature 3: Σ_xx is exactly 0)
+/// and a long chain of such refocusings keep a symmetric Σ with no negative diagonal in
+/// covariance form (it used to print −4.4e-16), and in square-root form.
+#[test]
+fn refocusing_chains_stay_psd_in_both_forms() {
+    let one = "Travel(distance: 0.3333333333333333), Curvature(k: 3.0)";
+    let long = vec![one; 200].join(", ");
+    for ops in [one.to_string(), long] {
+        let ron = common::tmp("hostile", "refocus.ron");
+        std::fs::write(
+            &ron,
+            format!("Path(source: Gaussian(x: 0.1, y: 0.1), operators: [{ops}])"),
+        )
+        .expect("write");
+        for form in ["covariance", "square-root"] {
+            let o = covtrace(&["eval", "--json", "--form", form, ron.to_str().expect("utf-8")]);
+            assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+            let json: serde_json::Value = serde_json::from_slice(&o.stdout).expect("json");
+            for (k, m) in matrices(&json).iter().enumerate() {
+                for i in 0..m.len() {
+                    assert!(
+                        m[i][i] >= 0.0 && m[i][i].is_finite(),
+                        "{form}, matrix {k}: Σ_{i}{i} = {}",
+                        m[i][i]
+                    );
+                    for j in 0..m.len() {
+                        assert_eq!(m[i][j], m[j][i], "{form}, matrix {k}: not symmetric");
+                    }
+                }
+            }
+        }
+    }
+}
+
+/// The worst inputs within the documented bounds run in bounded memory: a path file just
+/// under the 16 MiB cap (one operator list of 400,000 steps), evaluated and plotted, under a
+/// 2 GiB address-space limit (`ulimit -v`), and within a minute each.
+#[test]
+fn the_largest_inputs_run_in_bounded_memory() {
+    let ron = common::tmp("hostile", "huge.ron");
+    let ops = vec!["Travel(distance: 1.0)"; 400_000].join(",");
+    let text = format!("Path(source: Gaussian(x: 0.1), operators: [{ops}])");
+    assert!(text.len() < 16 << 20);
+    std::fs::write(&ron, text).expect("write");
+    let png = common::tmp("hostile", "huge.png");
+    let bin = env!("CARGO_BIN_EXE_covtrace");
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
+    for cmd in [
+        format!("'{bin}' eval '{}' > /dev/null", ron.display()),
+        format!(
+            "'{bin}' plot '{}' -o '{}' > /dev/null",
+            ron.display(),
+            png.display()
+        ),
+    ] {
+        let t = std::time::Instant::now();
+        let o = Command::new("bash")
+            .current_dir(&root)
+            .args(["-c", &format!("ulimit -v 2097152; {cmd}")])
+            .output()
+            .expect("bash");
+        assert!(
+            o.status.success(),
+            "{cmd}: {}",
+            String::from_utf8_lossy(&o.stderr)
+        );
+        // Not a timing test: a bound far above the measured seconds, to catch a hang.
+        assert!(t.elapsed().as_secs() < 60, "{cmd}");
+    }
+}

@@ -9,7 +9,7 @@ use crate::{Curvature, CurvatureTensor};
 /// `Curvature(k: 2.0)` (isotropic) or `Curvature(kx: 2.0, ky: -1.0, angle: 0.3)`.
 /// Also the form of the `curvature` field of composite operators: `(k: 2.0)`.
 #[derive(Clone, Copy, Debug, Default, Deserialize, OperatorSpec)]
-#[serde(deny_unknown_fields)]
+#[serde(deny_unknown_fields, rename = "Curvature")]
 #[operator(summary = "surface curvature in the surface frame, l(x, u + k·x)")]
 pub struct CurvatureSpec {
     /// Isotropic curvature (> 0 convex).

@@ -30,16 +30,88 @@ pub fn ron_options() -> ron::Options {
         .with_default_extension(Extensions::IMPLICIT_SOME | Extensions::UNWRAP_VARIANT_NEWTYPES)
 }
 
+/// A parser error in the path author's terms, at the place it concerns: an operator's
+/// parameter out of range at that parameter (ron reports it at the operator's end); a
+/// number where a name belongs, a decimal where a whole number belongs and the parser's
+/// recursion limit in words; everything else as ron says it.
+fn explain(text: &str, line: usize, col: usize, code: &ron::Error) -> (usize, usize, String) {
+    let msg = code.to_string();
+    // A custom message keeps the operator's name in front (`Travel: …`).
+    let (prefix, rest) = match msg.split_once(": ") {
+        Some((op, rest)) if !op.contains(' ') => (format!("{op}: "), rest.to_string()),
+        _ => (String::new(), msg.clone()),
+    };
+    if let Some(tail) = rest.strip_prefix("Found invalid std identifier \"") {
+        let found = tail.split('"').next().unwrap_or("");
+        return (
+            line,
+            col,
+            format!(
+                "{prefix}expected a name here (a parameter, an operator or an axis such as `x`), found `{}`",
+                cov_core::echo(found)
+            ),
+        );
+    }
+    if rest.starts_with("Exceeded recursion limit") {
+        return (
+            line,
+            col,
+            format!(
+                "{prefix}nested too deeply for the parser (operator lists may nest at most {} deep)",
+                crate::scan::MAX_NESTING
+            ),
+        );
+    }
+    if rest == "Expected comma" || matches!(code, ron::Error::ExpectedComma) {
+        let at: String = text
+            .lines()
+            .nth(line.saturating_sub(1))
+            .unwrap_or("")
+            .chars()
+            .skip(col.saturating_sub(1))
+            .take(2)
+            .collect();
+        if at.starts_with('.') || at.starts_with(['e', 'E']) {
+            return (
+                line,
+                col,
+                format!("{prefix}expected a whole number here, found a decimal number"),
+            );
+        }
+    }
+    // `parameter `name``: point at the parameter where it is written.
+    if let Some(tail) = rest.split("parameter `").nth(1)
+        && let Some(name) = tail.split('`').next()
+        && let Some((l, c)) = crate::scan::field_position(text, line, col, name)
+    {
+        return (l, c, msg);
+    }
+    (line, col, msg)
+}
+
 impl Path {
     /// Parses a path from RON text with the operators of `registry`.
     ///
     /// # Errors
     /// [`PathError::Parse`] with the line and column of the problem.
     pub fn parse(text: &str, registry: &Registry) -> Result<Path, PathError> {
+        let elements = crate::scan::operator_elements(text);
+        if let Some(e) = elements.iter().find(|e| e.depth > crate::scan::MAX_NESTING) {
+            return Err(PathError::Parse {
+                file: "<string>".into(),
+                line: e.line,
+                col: e.col,
+                message: format!(
+                    "operator lists nest {} deep here; at most {} (a `Moving` inside a `Moving` …)",
+                    e.depth,
+                    crate::scan::MAX_NESTING
+                ),
+            });
+        }
         // First pass: the declared layout, wherever it stands in the file, so that the
         // second pass can check every operator against it where it is written.
         let declared = ron_options().from_str_seed(text, LayoutProbe).ok().flatten();
-        let reader = Reader::new(registry, crate::scan::operator_elements(text));
+        let reader = Reader::new(registry, elements);
         let mut path = ron_options()
             .from_str_seed(
                 text,
@@ -48,11 +120,14 @@ impl Path {
                     declared,
                 },
             )
-            .map_err(|e| PathError::Parse {
-                file: "<string>".into(),
-                line: e.span.start.line,
-                col: e.span.start.col,
-                message: e.code.to_string(),
+            .map_err(|e| {
+                let (line, col, message) = explain(text, e.span.start.line, e.span.start.col, &e.code);
+                PathError::Parse {
+                    file: "<string>".into(),
+                    line,
+                    col,
+                    message,
+                }
             })?;
         let positions = crate::scan::operator_positions(text);
         if positions.len() == path.operators.len() {

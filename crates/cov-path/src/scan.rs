@@ -15,14 +15,21 @@ pub(crate) struct Element {
     pub top: bool,
     /// Whether its name is not followed by `(`.
     pub bare: bool,
+    /// Number of operator lists around it (1: the path's own).
+    pub depth: usize,
 }
 
-/// Every element of every operator list, in the order of the text.
-pub(crate) fn operator_elements(text: &str) -> Vec<Element> {
-    let chars: Vec<char> = text.chars().collect();
+/// Deepest nesting of operator lists a path may have (a `Moving` inside a `Moving` … 16
+/// lists deep). Deeper files are refused before parsing, with the position of the first
+/// element too deep; the parser's own recursion limit (128 levels, about 23 lists) stays
+/// a backstop that is never reached.
+pub const MAX_NESTING: usize = 16;
+
+/// `(line, col)`, 1-based, of every character of `chars`.
+fn char_positions(chars: &[char]) -> Vec<(usize, usize)> {
     let mut pos = Vec::with_capacity(chars.len());
     let (mut line, mut col) = (1usize, 1usize);
-    for &c in &chars {
+    for &c in chars {
         pos.push((line, col));
         if c == '\n' {
             line += 1;
@@ -31,6 +38,84 @@ pub(crate) fn operator_elements(text: &str) -> Vec<Element> {
             col += 1;
         }
     }
+    pos
+}
+
+/// Where the field `name` is written inside the operator whose closing parenthesis is at
+/// (or just before) `(line, col)`: ron reports errors of a whole operator (a parameter out
+/// of range) at its end; this finds `name:` at the operator's own level. `None` when the
+/// position is not the end of an operator or the field is not written there (a default).
+pub(crate) fn field_position(text: &str, line: usize, col: usize, name: &str) -> Option<(usize, usize)> {
+    let chars: Vec<char> = text.chars().collect();
+    let pos = char_positions(&chars);
+    let mut close = pos.iter().position(|&p| p == (line, col))?;
+    // ron may point just past the parenthesis.
+    while close > 0 && chars[close] != ')' && (chars[close].is_whitespace() || chars[close] == ',') {
+        close -= 1;
+    }
+    if chars[close] != ')' {
+        return None;
+    }
+    // The matching `(`, counting brackets backwards.
+    let mut depth = 0usize;
+    let mut open = None;
+    for i in (0..close).rev() {
+        match chars[i] {
+            ')' | ']' | '}' => depth += 1,
+            '(' | '[' | '{' if depth == 0 => {
+                open = Some(i);
+                break;
+            }
+            '(' | '[' | '{' => depth -= 1,
+            _ => {}
+        }
+    }
+    let open = open?;
+    // `name` followed by `:` at the operator's own level.
+    let mut i = open + 1;
+    let mut level = 0usize;
+    while i < close {
+        if let Some(next) = skip_comment(&chars, i) {
+            i = next;
+            continue;
+        }
+        let c = chars[i];
+        if c == '"' {
+            i = skip_string(&chars, i);
+            continue;
+        }
+        match c {
+            '(' | '[' | '{' => level += 1,
+            ')' | ']' | '}' => level = level.saturating_sub(1),
+            _ => {}
+        }
+        let starts = (c.is_alphabetic() || c == '_')
+            && (i == 0 || !(chars[i - 1].is_alphanumeric() || chars[i - 1] == '_'));
+        if level == 0 && starts {
+            let mut j = i;
+            while j < close && (chars[j].is_alphanumeric() || chars[j] == '_') {
+                j += 1;
+            }
+            let word: String = chars[i..j].iter().collect();
+            let mut k = j;
+            while k < close && chars[k].is_whitespace() {
+                k += 1;
+            }
+            if word == name && chars.get(k) == Some(&':') {
+                return Some(pos[i]);
+            }
+            i = j;
+            continue;
+        }
+        i += 1;
+    }
+    None
+}
+
+/// Every element of every operator list, in the order of the text.
+pub(crate) fn operator_elements(text: &str) -> Vec<Element> {
+    let chars: Vec<char> = text.chars().collect();
+    let pos = char_positions(&chars);
     // Stack of open brackets: true for an operator list.
     let mut stack: Vec<bool> = Vec::new();
     let mut out = Vec::new();
@@ -72,6 +157,7 @@ pub(crate) fn operator_elements(text: &str) -> Vec<Element> {
                 col,
                 top: stack.iter().filter(|&&b| b).count() == 1,
                 bare: j > i && chars.get(k) != Some(&'('),
+                depth: stack.iter().filter(|&&b| b).count(),
             });
         }
         if c.is_alphanumeric() || c == '_' {
@@ -168,6 +254,16 @@ mod tests {
         assert!(operator_positions("Path(source: X)").is_empty());
         let t = "Path(\n    source: Matrix(rows: [[1e300, 0.0], [0.0, 1e300]]),\n    operators: [Curvature(k: 1e10)],\n)\n";
         assert_eq!(operator_positions(t), vec![(3, 17)]);
+    }
+
+    #[test]
+    fn finds_a_field_of_the_operator_that_ends_at_a_position() {
+        let t = "Path(\n  operators: [\n    Reflect(\n      cos_in: 0.8, // cos_out: 1\n      lobe: Phong(cos_out: 3),\n      cos_out: 2.9,\n    ),\n  ],\n)\n";
+        // The `)` closing Reflect is at 7:5.
+        assert_eq!(field_position(t, 7, 5, "cos_out"), Some((6, 7)));
+        assert_eq!(field_position(t, 7, 5, "cos_in"), Some((4, 7)));
+        assert_eq!(field_position(t, 7, 5, "turn"), None);
+        assert_eq!(field_position(t, 1, 1, "cos_in"), None);
     }
 
     #[test]

@@ -90,6 +90,14 @@ impl Source {
                             "Gaussian source: std `{axis}` = {s} must be > 0 (inf: constant)"
                         ));
                     }
+                    if let Some(s) = std
+                        && !(1.0 / (cov_core::FOUR_PI_SQ * s * s)).is_finite()
+                    {
+                        return Err(format!(
+                            "Gaussian source: std `{axis}` = {} is too small: its spectrum variance 1/(4π² s²) overflows f64",
+                            cov_core::num(s)
+                        ));
+                    }
                 }
             }
             Source::Dirac {
@@ -101,7 +109,7 @@ impl Source {
                     *scene_scale,
                     relative_size.unwrap_or(cov_core::DIRAC_RELATIVE_SIZE),
                 )
-                .map_err(|e| format!("Dirac source: {e}"))?;
+                .map_err(|e| format!("Dirac source: {}", user_words(&e)))?;
             }
             Source::Matrix { rows } => {
                 let n = rows.len();
@@ -111,7 +119,7 @@ impl Source {
                         rows.iter().map(Vec::len).collect::<Vec<_>>()
                     ));
                 }
-                AnyCov::from_rows(rows).map_err(|e| format!("Matrix source: {e}"))?;
+                AnyCov::from_rows(rows).map_err(|e| format!("Matrix source: {}", user_words(&e)))?;
                 if let Some(l) = layout
                     && l != n
                 {
@@ -165,5 +173,15 @@ impl Source {
                 AnyCov::from_rows(rows)
             }
         }
+    }
+}
+
+/// A core error in the path author's words: without the name of the library function that
+/// raised it (`Cov::dirac: …`), which means nothing in a path file.
+fn user_words(e: &cov_core::CovError) -> String {
+    let s = e.to_string();
+    match s.split_once(": ") {
+        Some((op, rest)) if op.contains("::") => rest.to_string(),
+        _ => s,
     }
 }

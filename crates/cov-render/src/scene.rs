@@ -159,7 +159,7 @@ pub struct SceneFile {
 
 /// The camera.
 #[derive(Clone, Debug, Deserialize)]
-#[serde(deny_unknown_fields)]
+#[serde(deny_unknown_fields, rename = "Camera")]
 pub struct CameraDesc {
     /// Centre of the lens (m).
     pub position: V3,
@@ -187,7 +187,7 @@ pub struct CameraDesc {
 
 /// A thin lens.
 #[derive(Clone, Debug, Deserialize)]
-#[serde(deny_unknown_fields)]
+#[serde(deny_unknown_fields, rename = "Lens")]
 pub struct LensDesc {
     /// Lens radius (m); 0 is a pinhole.
     pub aperture: NonNegative,
@@ -200,7 +200,7 @@ pub struct LensDesc {
 
 /// The shutter interval (s).
 #[derive(Clone, Debug, Deserialize)]
-#[serde(deny_unknown_fields)]
+#[serde(deny_unknown_fields, rename = "Shutter")]
 pub struct ShutterDesc {
     /// Opening time.
     pub open: Finite,
@@ -210,7 +210,7 @@ pub struct ShutterDesc {
 
 /// A material.
 #[derive(Clone, Debug, Deserialize)]
-#[serde(deny_unknown_fields)]
+#[serde(deny_unknown_fields, rename = "Material")]
 pub enum MaterialDesc {
     /// Lambertian.
     Diffuse {
@@ -235,7 +235,7 @@ pub enum MaterialDesc {
 
 /// An area light.
 #[derive(Clone, Debug, Deserialize)]
-#[serde(deny_unknown_fields)]
+#[serde(deny_unknown_fields, rename = "Light")]
 pub enum LightDesc {
     /// A parallelogram emitting on the side of `edge_u × edge_v`.
     Rect {
@@ -261,7 +261,7 @@ pub enum LightDesc {
 
 /// A shape.
 #[derive(Clone, Debug, Deserialize)]
-#[serde(deny_unknown_fields)]
+#[serde(deny_unknown_fields, rename = "Shape")]
 pub enum ShapeDesc {
     /// A sphere.
     Sphere {

@@ -13,6 +13,16 @@ use crate::{AnyCov, AnySpectrum, Cov, CovError, Form, Spectrum};
 /// [`Spectrum::integrate`].
 pub const SCHUR_SNAP: f64 = 64.0 * f64::EPSILON;
 
+/// A new diagonal entry computed as a quadratic form `xᵀ Σ x` of a PSD Σ: never negative
+/// in exact arithmetic, so a negative result is cancellation below rounding (`Travel`
+/// then `Curvature` refocusing a ray gives `Σ_xx = −4.4e-16` for a true 0). Its magnitude
+/// is kept, not zeroed: the error stays within the rounding band and errs towards a
+/// larger bandwidth (more samples), never towards a negative or a zero one.
+#[inline(always)]
+fn quadratic(v: f64) -> f64 {
+    v.abs()
+}
+
 impl<const N: usize> Spectrum for Cov<N> {
     #[inline(always)]
     fn dim(&self) -> usize {
@@ -53,7 +63,9 @@ impl<const N: usize> Spectrum for Cov<N> {
         let old = *self;
         for i in 0..N {
             for j in i..N {
-                self.set(i, j, (0..N).map(|k| a[k][i] * b[k][j]).sum());
+                let v: f64 = (0..N).map(|k| a[k][i] * b[k][j]).sum();
+                // A diagonal is the quadratic form a_iᵀ Σ a_i ≥ 0 (see `quadratic`).
+                self.set(i, j, if i == j { quadratic(v) } else { v });
             }
         }
         self.finish(op, old)
@@ -65,7 +77,7 @@ impl<const N: usize> Spectrum for Cov<N> {
         let mut col = [0.0; N];
         for (k, c) in col.iter_mut().enumerate() {
             *c = if k == j {
-                self.get(j, j) + s * (2.0 * self.get(i, j) + s * self.get(i, i))
+                quadratic(self.get(j, j) + s * (2.0 * self.get(i, j) + s * self.get(i, i)))
             } else {
                 self.get(k, j) + s * self.get(k, i)
             };
@@ -200,8 +212,8 @@ impl<const N: usize> Cov<N> {
             }
         }
         let cs = c * s;
-        self.set(i, i, c * c * sii + 2.0 * cs * sij + s * s * sjj);
-        self.set(j, j, s * s * sii - 2.0 * cs * sij + c * c * sjj);
+        self.set(i, i, quadratic(c * c * sii + 2.0 * cs * sij + s * s * sjj));
+        self.set(j, j, quadratic(s * s * sii - 2.0 * cs * sij + c * c * sjj));
         self.set(i, j, cs * (sjj - sii) + (c * c - s * s) * sij);
     }
 
