@@ -9,7 +9,11 @@ use crate::{AnyCov, AnySpectrum, Cov, CovError, Form, Spectrum};
 /// Relative level below which a diagonal entry of a Schur complement is rounding noise
 /// (dimensionless, relative to the same entry before the update): `64 ε ≈ 1.4e-14`.
 /// Cancellation in `Σ_aa − Σ_ap Σ_pp⁻¹ Σ_pa` leaves an error of a few ε × `Σ_aa`; what
-/// remains below `64 ε` is not information. See [`Spectrum::convolve`] and
+/// remains below `64 ε` is not information. The snap sets such an entry to 0 with its row
+/// and column: it errs towards a smaller bandwidth, and is exact when the true value is 0
+/// (a point light through a diffuse bounce). Where the true value is small but well
+/// determined by the parameters, the covariance form cannot hold it; the square-root form
+/// can ([`crate::CovFactor`], no snap on lobes). See [`Spectrum::convolve`] and
 /// [`Spectrum::integrate`].
 pub const SCHUR_SNAP: f64 = 64.0 * f64::EPSILON;
 
