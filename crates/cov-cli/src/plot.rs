@@ -161,8 +161,10 @@ fn ellipse(s: [f64; 3]) -> Vec<(f64, f64)> {
 }
 
 /// Tick labels like `1.5e3`: short, with an exponent.
-fn tick(v: &f64) -> String {
-    if *v == 0.0 {
+fn tick(v: &f64, range: f64) -> String {
+    // A tick meant for 0 carries the rounding of the axis arithmetic (1.2e83 on an axis
+    // of ±1e99): anything below 1e-9 of the range is 0.
+    if v.abs() <= 1e-9 * range {
         "0".into()
     } else {
         let s = format!("{v:.1e}");
@@ -270,8 +272,8 @@ fn draw_panel(
         .configure_mesh()
         .x_labels(5)
         .y_labels(5)
-        .x_label_formatter(&tick)
-        .y_label_formatter(&tick)
+        .x_label_formatter(&|v| tick(v, sx))
+        .y_label_formatter(&|v| tick(v, sy))
         .x_desc("Ω position [cycles/m]")
         .y_desc("Ω direction [cycles/tan]")
         .label_style(("sans-serif", 11))
@@ -283,7 +285,7 @@ fn draw_panel(
         chart
             .configure_secondary_axes()
             .y_labels(5)
-            .y_label_formatter(&tick)
+            .y_label_formatter(&|v| tick(v, st.unwrap_or(1.0)))
             .y_desc("Ω time [cycles/s]")
             .label_style(("sans-serif", 11))
             .axis_desc_style(("sans-serif", 11))

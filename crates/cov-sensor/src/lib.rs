@@ -574,7 +574,18 @@ impl Integrate {
 }
 
 impl Operator for Integrate {
+    /// # Errors
+    /// Every axis of the layout integrated: Σ would be the empty matrix, which describes
+    /// nothing (a renderer integrates over what it samples and keeps the image axes).
     fn apply(&self, cov: &mut dyn Spectrum) -> Result<(), CovError> {
+        if cov.axes().iter().all(|a| self.axes.contains(a)) {
+            return Err(CovError::OutOfRange {
+                operator: Self::NAME.into(),
+                parameter: "axes".into(),
+                value: self.axes.len() as f64,
+                expected: "must leave at least one axis of the layout: integrating every axis leaves nothing to describe".into(),
+            });
+        }
         cov.integrate(&self.axes)
     }
     fn requires(&self) -> AxisSet {
