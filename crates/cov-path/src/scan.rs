@@ -71,7 +71,14 @@ pub(crate) fn field_position(text: &str, line: usize, col: usize, name: &str) ->
         }
     }
     let open = open?;
-    // `name` followed by `:` at the operator's own level.
+    // A parameter `values[2]` is element 2 of the list `values`.
+    let (name, element) = match name.split_once('[') {
+        Some((n, rest)) => (n, rest.trim_end_matches(']').parse::<usize>().ok()),
+        None => (name, None),
+    };
+    // `name` followed by `:`, at the operator's own level first, else inside a nested
+    // parameter (a `Tabulated(...)` phase).
+    let mut found: Option<(usize, usize)> = None; // (level, index after the `:`)
     let mut i = open + 1;
     let mut level = 0usize;
     while i < close {
@@ -91,7 +98,7 @@ pub(crate) fn field_position(text: &str, line: usize, col: usize, name: &str) ->
         }
         let starts = (c.is_alphabetic() || c == '_')
             && (i == 0 || !(chars[i - 1].is_alphanumeric() || chars[i - 1] == '_'));
-        if level == 0 && starts {
+        if starts {
             let mut j = i;
             while j < close && (chars[j].is_alphanumeric() || chars[j] == '_') {
                 j += 1;
@@ -101,15 +108,39 @@ pub(crate) fn field_position(text: &str, line: usize, col: usize, name: &str) ->
             while k < close && chars[k].is_whitespace() {
                 k += 1;
             }
-            if word == name && chars.get(k) == Some(&':') {
-                return Some(pos[i]);
+            if word == name && chars.get(k) == Some(&':') && found.is_none_or(|(l, _)| level < l) {
+                found = Some((level, i));
             }
             i = j;
             continue;
         }
         i += 1;
     }
-    None
+    let (_, at) = found?;
+    let Some(k) = element else {
+        return Some(pos[at]);
+    };
+    // Element k of the list after `name:`: count the commas at the list's own level.
+    let mut i = at;
+    while i < close && chars[i] != '[' {
+        i += 1;
+    }
+    let mut depth = 0usize;
+    let mut index = 0usize;
+    let mut j = i + 1;
+    while j < close {
+        match chars[j] {
+            '(' | '[' | '{' => depth += 1,
+            ')' | '}' => depth = depth.saturating_sub(1),
+            ']' if depth == 0 => break,
+            ']' => depth -= 1,
+            ',' if depth == 0 => index += 1,
+            c if index == k && depth == 0 && !c.is_whitespace() => return Some(pos[j]),
+            _ => {}
+        }
+        j += 1;
+    }
+    Some(pos[at])
 }
 
 /// Every element of every operator list, in the order of the text.
@@ -264,6 +295,10 @@ mod tests {
         assert_eq!(field_position(t, 7, 5, "cos_in"), Some((4, 7)));
         assert_eq!(field_position(t, 7, 5, "turn"), None);
         assert_eq!(field_position(t, 1, 1, "cos_in"), None);
+        // An element of a list inside a nested parameter.
+        let t = "Scatter(\n  angle: 0.3,\n  phase: Tabulated(\n    angles: [0.0, 0.5, 0.2],\n    values: [1, 1, 1],\n  ),\n)";
+        assert_eq!(field_position(t, 7, 1, "angles[2]"), Some((4, 24)));
+        assert_eq!(field_position(t, 7, 1, "values"), Some((5, 5)));
     }
 
     #[test]
