@@ -15,7 +15,7 @@ use cov_render::bench::{Guide, Method, Run, error, fit_loglog, run, speedup};
 use cov_render::render::{
     STRIDES, covariance_maps_strided, read_image, render_adaptive, tile_count, timed, tonemap, write_image,
 };
-use cov_render::{MAX_COV_PATHS, MAX_SPP, World};
+use cov_render::{MAX_SPP, World};
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
@@ -159,15 +159,7 @@ fn check_args(a: &BenchArgs) -> Result<(Vec<Method>, Vec<f64>), String> {
             ));
         }
     }
-    if a.ref_spp == 0 || a.ref_spp > MAX_SPP {
-        return Err(format!("--ref-spp must be 1 to {MAX_SPP}, got {}", a.ref_spp));
-    }
-    if a.cov_paths == 0 || a.cov_paths > MAX_COV_PATHS {
-        return Err(format!(
-            "--cov-paths must be 1 to {MAX_COV_PATHS}, got {}",
-            a.cov_paths
-        ));
-    }
+    crate::render::check_counts(a.ref_spp, a.cov_paths)?;
     if !(1..=10).contains(&a.repeat) {
         return Err(format!("--repeat must be 1 to 10, got {}", a.repeat));
     }

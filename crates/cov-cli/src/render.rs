@@ -87,6 +87,22 @@ pub fn check_output(out: &Path, ext: &str) -> Result<(), String> {
     Ok(())
 }
 
+/// Checks `--ref-spp` (1 to [`MAX_SPP`]) and `--cov-paths` (1 to [`MAX_COV_PATHS`]).
+///
+/// # Errors
+/// Either out of range, named as the user wrote it.
+pub fn check_counts(ref_spp: u32, cov_paths: u32) -> Result<(), String> {
+    if ref_spp == 0 || ref_spp > MAX_SPP {
+        return Err(format!("--ref-spp must be 1 to {MAX_SPP}, got {ref_spp}"));
+    }
+    if cov_paths == 0 || cov_paths > MAX_COV_PATHS {
+        return Err(format!(
+            "--cov-paths must be 1 to {MAX_COV_PATHS}, got {cov_paths}"
+        ));
+    }
+    Ok(())
+}
+
 /// A progress bar over `len` tiles labelled `what`.
 pub fn bar(len: usize, what: &str) -> ProgressBar {
     let b = ProgressBar::new(len as u64);
@@ -191,15 +207,7 @@ pub struct CheckArgs {
 /// # Errors
 /// A bad scene or arguments, an unwritable JSON file.
 pub fn check(a: &CheckArgs) -> Result<String, String> {
-    if a.ref_spp == 0 || a.ref_spp > MAX_SPP {
-        return Err(format!("--ref-spp must be 1 to {MAX_SPP}, got {}", a.ref_spp));
-    }
-    if a.cov_paths == 0 || a.cov_paths > MAX_COV_PATHS {
-        return Err(format!(
-            "--cov-paths must be 1 to {MAX_COV_PATHS}, got {}",
-            a.cov_paths
-        ));
-    }
+    check_counts(a.ref_spp, a.cov_paths)?;
     if let Some(j) = &a.json {
         check_output(j, "json")?;
     }
