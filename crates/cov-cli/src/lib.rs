@@ -9,6 +9,12 @@
 //! - `covtrace stiff [--length N]`: the stiff suite (cov-stiff): extreme chains in both
 //!   forms and in plain f64, against a double-double reference.
 //! - `covtrace list`: the registered operators with their parameters and units.
+//! - `covtrace render SCENE.ron [--spp N] [-o OUT.exr]`: a uniform render, with the
+//!   covariance pass's density and filter maps.
+//! - `covtrace render-check SCENE.ron`: predicted against measured local spectra, tile by tile.
+//! - `covtrace render-bench SCENE.ron [--budgets 2,4,…] [-o DIR]`: every sampling and
+//!   reconstruction method against a cached reference: error against time, the equal-error
+//!   speed-up, an equal-time strip ([`bench`]).
 //!
 //! Every error is one line, `file:line:column: message`, with exit code 2.
 
