@@ -14,7 +14,7 @@
 //! - `covtrace render-check SCENE.ron`: predicted against measured local spectra, tile by tile.
 //! - `covtrace render-bench SCENE.ron [--budgets 2,4,…] [-o DIR]`: every sampling and
 //!   reconstruction method against a cached reference: error against time, the equal-error
-//!   speed-up, an equal-time strip ([`bench`]).
+//!   speed-up, an equal-time strip ([`mod@bench`]).
 //!
 //! Every error is one line, `file:line:column: message`, with exit code 2.
 
