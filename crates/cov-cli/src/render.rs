@@ -236,25 +236,17 @@ pub fn check(a: &CheckArgs) -> Result<String, String> {
     let clamp = if mean_l > 0.0 { 4.0 * mean_l } else { f64::INFINITY };
     let b = bar(2 * tiles, "reference");
     let counts = vec![a.ref_spp; (w * h) as usize];
-    let ((ref_a, ref_b), t_ref) = timed(|| {
-        let ra = render_clamped(
+    let reference = |k: u64| {
+        render_clamped(
             &world,
             &counts,
-            a.seed.wrapping_add(1000),
+            a.seed.wrapping_add(k * 1000),
             clamp,
             Some(&|| b.inc(1)),
         )
-        .0;
-        let rb = render_clamped(
-            &world,
-            &counts,
-            a.seed.wrapping_add(2000),
-            clamp,
-            Some(&|| b.inc(1)),
-        )
-        .0;
-        (ra, rb)
-    });
+        .0
+    };
+    let ((ref_a, ref_b), t_ref) = timed(|| (reference(1), reference(2)));
     b.finish_and_clear();
     let b = bar(tiles, "covariance");
     let (maps, t_cov) = timed(|| covariance_maps_with(&world, a.cov_paths, a.seed, Some(&|| b.inc(1))));

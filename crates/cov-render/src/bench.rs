@@ -21,7 +21,7 @@ use std::time::Instant;
 
 use crate::covpass::PixelCov;
 use crate::film::{Film, Filter, Gaussian};
-use crate::render::{CovMaps, Image, MAX_SPP, Progress, content};
+use crate::render::{CovMaps, Image, MAX_SPP, Progress, content, image_filter};
 use crate::trace::luminance;
 use crate::world::World;
 
@@ -144,15 +144,20 @@ pub fn allocate(weights: &[f64], total: f64, lo: u32, hi: u32) -> Vec<u32> {
 /// Gaussian whose spectrum matches the image's content ([`content`]), from the core's
 /// `reconstruction_filter` (clamped at [`MAX_FILTER`]).
 pub fn filter_cov(p: &PixelCov) -> [f64; 3] {
-    let s = content(p.sigma, PIXEL_FILTER);
-    let mut c = cov_core::Cov::<2>::zeros();
-    c.set(0, 0, s[0]);
-    c.set(0, 1, s[1]);
-    c.set(1, 1, s[2]);
-    match c.block().reconstruction_filter(&[MAX_FILTER; 2]) {
-        Ok(f) => [f.covariance[(0, 0)], f.covariance[(0, 1)], f.covariance[(1, 1)]],
-        Err(_) => [MAX_FILTER * MAX_FILTER, 0.0, MAX_FILTER * MAX_FILTER],
+    match image_filter(content(p.sigma, PIXEL_FILTER), MAX_FILTER) {
+        Some(f) => [f.covariance[(0, 0)], f.covariance[(0, 1)], f.covariance[(1, 1)]],
+        None => [MAX_FILTER * MAX_FILTER, 0.0, MAX_FILTER * MAX_FILTER],
     }
+}
+
+/// The pixels of a `w × h` image within `r` pixels (a square) of pixel `i`, with their
+/// squared distance to it.
+fn around(w: i64, h: i64, i: i64, r: i64) -> impl Iterator<Item = (usize, i64)> {
+    let (x, y) = (i % w, i / w);
+    ((y - r).max(0)..=(y + r).min(h - 1)).flat_map(move |yy| {
+        ((x - r).max(0)..=(x + r).min(w - 1))
+            .map(move |xx| ((yy * w + xx) as usize, (xx - x).pow(2) + (yy - y).pow(2)))
+    })
 }
 
 /// Narrows every filter so that it does not reach, at [`EDGE_REACH`] of its own std, a
@@ -166,16 +171,11 @@ pub fn edge_clamp(width: u32, height: u32, raw: &[Gaussian]) -> Vec<Gaussian> {
         .map(|i| {
             let g = raw[i as usize];
             let s = g.std_max();
-            let (x, y) = (i % w, i / w);
-            let r = (EDGE_REACH * s).ceil() as i64;
             let mut limit = s;
-            for yy in (y - r).max(0)..=(y + r).min(h - 1) {
-                for xx in (x - r).max(0)..=(x + r).min(w - 1) {
-                    let sk = raw[(yy * w + xx) as usize].std_max();
-                    if sk < limit {
-                        let d = (((xx - x) * (xx - x) + (yy - y) * (yy - y)) as f64).sqrt();
-                        limit = limit.min(sk.max(d / EDGE_REACH));
-                    }
+            for (j, d2) in around(w, h, i, (EDGE_REACH * s).ceil() as i64) {
+                let sk = raw[j].std_max();
+                if sk < limit {
+                    limit = limit.min(sk.max((d2 as f64).sqrt() / EDGE_REACH));
                 }
             }
             if limit < s {
@@ -224,17 +224,13 @@ pub fn adapted_filters(guide: &Guide, film: &Film) -> Vec<Gaussian> {
     let raw: Vec<Gaussian> = (0..w * h)
         .into_par_iter()
         .map(|i| {
-            let (x, y) = (i % w, i / w);
             let (mut v, mut imax, mut m1, mut m2, mut k) = (0.0, 0.0f64, 0.0, 0.0, 0.0);
-            for yy in (y - 1).max(0)..=(y + 1).min(h - 1) {
-                for xx in (x - 1).max(0)..=(x + 1).min(w - 1) {
-                    let j = (yy * w + xx) as usize;
-                    v += var[j];
-                    imax = imax.max(lum[j]);
-                    m1 += lum[j];
-                    m2 += lum[j] * lum[j];
-                    k += 1.0;
-                }
+            for (j, _) in around(w, h, i, 1) {
+                v += var[j];
+                imax = imax.max(lum[j]);
+                m1 += lum[j];
+                m2 += lum[j] * lum[j];
+                k += 1.0;
             }
             let n = f64::from(film.count[i as usize].max(1));
             let v = if film.count[i as usize] >= 2 {
@@ -446,15 +442,7 @@ fn relative_variance(film: &Film) -> Vec<f64> {
         .collect();
     (0..w * h)
         .map(|i| {
-            let (x, y) = (i % w, i / w);
-            let mut s = 0.0;
-            let mut k = 0.0;
-            for yy in (y - 1).max(0)..=(y + 1).min(h - 1) {
-                for xx in (x - 1).max(0)..=(x + 1).min(w - 1) {
-                    s += raw[(yy * w + xx) as usize];
-                    k += 1.0;
-                }
-            }
+            let (s, k) = around(w, h, i, 1).fold((0.0, 0.0), |(s, k), (j, _)| (s + raw[j], k + 1.0));
             s / k
         })
         .collect()

@@ -428,17 +428,21 @@ pub fn content(s: [f64; 3], pixel_filter: f64) -> [f64; 3] {
     [a, b.clamp(-lim, lim), c]
 }
 
-/// The reconstruction filter's larger std (px) for an image-space Σ `[xx, xy, yy]`: the
+/// The reconstruction filter of an image-space Σ `[xx, xy, yy]` (cycles/px)²: the
 /// sensor's rule (`CovBlock::reconstruction_filter`: the Gaussian whose spectrum matches,
-/// clamped at `max_filter` where Σ is small or singular).
-pub fn filter_std(s: [f64; 3], max_filter: f64) -> f64 {
+/// clamped at `max_filter` px where Σ is small or singular). `None` for a Σ the rule
+/// rejects (not finite).
+pub fn image_filter(s: [f64; 3], max_filter: f64) -> Option<cov_core::Filter> {
     let mut c = cov_core::Cov::<2>::zeros();
     c.set(0, 0, s[0]);
     c.set(0, 1, s[1]);
     c.set(1, 1, s[2]);
-    c.block()
-        .reconstruction_filter(&[max_filter; 2])
-        .map_or(max_filter, |f| {
-            f.extents.iter().fold(0.0, |m: f64, v| m.max(*v)).min(max_filter)
-        })
+    c.block().reconstruction_filter(&[max_filter; 2]).ok()
+}
+
+/// The reconstruction filter's larger std (px) for an image-space Σ ([`image_filter`]).
+pub fn filter_std(s: [f64; 3], max_filter: f64) -> f64 {
+    image_filter(s, max_filter).map_or(max_filter, |f| {
+        f.extents.iter().fold(0.0, |m: f64, v| m.max(*v)).min(max_filter)
+    })
 }

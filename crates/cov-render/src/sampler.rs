@@ -74,16 +74,6 @@ impl Sampler for SobolSampler {
     }
 }
 
-/// Any random number generator as a [`Sampler`] (independent uniform numbers).
-#[derive(Clone, Debug)]
-pub struct RngSampler<R>(pub R);
-
-impl<R: rand::Rng> Sampler for RngSampler<R> {
-    fn next(&mut self) -> f64 {
-        self.0.random()
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -5,6 +5,8 @@ use std::path::{Path, PathBuf};
 use cov_render::World;
 use cov_render::render::{covariance_maps, render, render_adaptive};
 
+mod common;
+
 fn scenes() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/scenes")
 }
@@ -45,25 +47,13 @@ fn every_bundled_scene_renders_the_same_on_one_and_two_threads() {
     }
 }
 
-/// One pixel seeing a diffuse plane (ρ = 0.5) from 1 m above, under a sphere light
-/// (L = 1, R = 0.5 m) whose centre is D = 2 m above the point seen.
-fn plane_under_sphere_light() -> World {
-    let text = r#"Scene(
-        camera: (position: (0.0, 1.0, 0.0), look_at: (0.0, 0.0, 0.0), up: (0.0, 0.0, -1.0), fov: 0.5, width: 1, height: 1),
-        materials: { "grey": Diffuse(albedo: (0.5, 0.5, 0.5)) },
-        lights: [Sphere(center: (0.0, 2.0, 0.0), radius: 0.5, radiance: (1.0, 1.0, 1.0))],
-        shapes: [Quad(corner: (-50.0, 0.0, -50.0), edge_u: (100.0, 0.0, 0.0), edge_v: (0.0, 0.0, 100.0), material: "grey")],
-    )"#;
-    World::from_text(text, "<test>", Path::new(".")).unwrap()
-}
-
 /// A diffuse plane of albedo ρ under a sphere light of radiance L and radius R whose
 /// centre is D above the point seen: the irradiance is `π L (R/D)²`, so the radiance
 /// leaving the plane is `ρ L (R/D)²`. The estimator (MIS direct light plus a bounce that
 /// only finds the light) must match it within its Monte Carlo error.
 #[test]
 fn a_diffuse_plane_under_a_sphere_light_matches_the_closed_form() {
-    let world = plane_under_sphere_light();
+    let world = common::plane_under_sphere_light(0.5, 1, 1);
     let n = 20_000u32;
     let (img, var) = render_adaptive(&world, &[n], 3, None);
     let exact = 0.5 * (0.5f64 / 2.0).powi(2);
@@ -81,7 +71,7 @@ fn a_diffuse_plane_under_a_sphere_light_matches_the_closed_form() {
 /// estimate unbiased: a diffuse plane under a sphere light (closed form `ρ L (R/D)²`, as above) estimated from 3 001 then 9 000 more samples matches within 4σ.
 #[test]
 fn a_two_pass_estimate_matches_the_closed_form() {
-    let world = plane_under_sphere_light();
+    let world = common::plane_under_sphere_light(0.5, 1, 1);
     let mut film = cov_render::film::Film::new(1, 1);
     film.render(&world, &[3001], 5, f64::INFINITY, None);
     film.render(&world, &[9000], 5, f64::INFINITY, None);

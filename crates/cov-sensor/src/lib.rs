@@ -358,7 +358,7 @@ impl Sensor {
                 sampled[i][j] = (0..k).map(|l| a[l][i] * ba[l][j]).sum();
             }
         }
-        let det = psd_det(k, &mut sampled);
+        let det = cov_core::linalg::psd_det(k, &mut sampled);
         let density = (2.0 * self.p.nyquist).powi(k as i32) * det.sqrt();
         let root2pi = (2.0 * PI).sqrt();
         let mut span = 1.0;
@@ -440,36 +440,6 @@ impl Sensor {
     pub fn decisions_rows(&self, rows: &[Vec<f64>]) -> Result<PixelDecisions, CovError> {
         self.decisions(AnyCov::from_rows(rows)?)
     }
-}
-
-/// The determinant of the PSD matrix `m` (its first `k` rows and columns; overwritten),
-/// by Cholesky with symmetric pivoting: the largest remaining diagonal first, and 0 as
-/// soon as no positive pivot is left (rank deficient: the sampled domain has a flat
-/// direction). Cheaper than eigenvalues, and as accurate for PSD input.
-fn psd_det(k: usize, m: &mut [[f64; MAX]; MAX]) -> f64 {
-    let mut det = 1.0;
-    let mut order = [0, 1, 2, 3, 4];
-    for s in 0..k {
-        // Pivot: the largest remaining diagonal.
-        let p = (s..k)
-            .max_by(|&a, &b| m[order[a]][order[a]].total_cmp(&m[order[b]][order[b]]))
-            .unwrap_or(s);
-        order.swap(s, p);
-        let d = m[order[s]][order[s]];
-        if d.is_nan() || d <= 0.0 {
-            return 0.0;
-        }
-        det *= d;
-        // Schur complement on the remaining rows.
-        let r = order[s];
-        for &i in &order[s + 1..k] {
-            let f = m[i][r] / d;
-            for &j in &order[s + 1..k] {
-                m[i][j] -= f * m[r][j];
-            }
-        }
-    }
-    det
 }
 
 /// The image block in pixel units, from Σ integrated over everything but position.
@@ -590,42 +560,5 @@ impl Operator for Integrate {
     }
     fn requires(&self) -> AxisSet {
         AxisSet::of(&self.axes).union(AxisSet::FLAT)
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    /// The pivoted Cholesky determinant agrees with the product of eigenvalues on PSD
-    /// matrices of every size, full rank or not.
-    #[test]
-    fn psd_det_matches_the_eigenvalues() {
-        let mut seed = 12345u64;
-        let mut next = || {
-            seed = seed
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            (seed >> 11) as f64 / (1u64 << 53) as f64 - 0.5
-        };
-        for k in 1..=5 {
-            for rank in 1..=k {
-                let g: Vec<Vec<f64>> = (0..k).map(|_| (0..rank).map(|_| next()).collect()).collect();
-                let mut m = [[0.0; MAX]; MAX];
-                for i in 0..k {
-                    for j in 0..k {
-                        m[i][j] = (0..rank).map(|l| g[i][l] * g[j][l]).sum();
-                    }
-                }
-                let (vals, _) = cov_core::linalg::sym_eigen(k, &m);
-                let want: f64 = vals[..k].iter().map(|v| v.max(0.0)).product();
-                let got = psd_det(k, &mut m.clone());
-                let scale = (0..k).map(|i| m[i][i]).product::<f64>().max(1e-300);
-                assert!(
-                    (got - want).abs() <= 1e-10 * scale,
-                    "k {k} rank {rank}: {got} vs {want}"
-                );
-            }
-        }
     }
 }

@@ -86,18 +86,7 @@ impl<const N: usize> Spectrum for Cov<N> {
                 self.get(k, j) + s * self.get(k, i)
             };
         }
-        if let Some(k) = col.iter().position(|v| !v.is_finite()) {
-            return Err(CovError::Overflow {
-                operator: op.into(),
-                row: k.min(j),
-                col: k.max(j),
-                value: col[k],
-            });
-        }
-        for (k, c) in col.iter().enumerate() {
-            self.set(k, j, *c);
-        }
-        Ok(())
+        self.commit_column(op, j, &col)
     }
 
     #[inline(always)]
@@ -107,18 +96,7 @@ impl<const N: usize> Spectrum for Cov<N> {
         for (k, v) in col.iter_mut().enumerate() {
             *v = self.get(k, i) * if k == i { c * c } else { c };
         }
-        if let Some(k) = col.iter().position(|v| !v.is_finite()) {
-            return Err(CovError::Overflow {
-                operator: op.into(),
-                row: k.min(i),
-                col: k.max(i),
-                value: col[k],
-            });
-        }
-        for (k, v) in col.iter().enumerate() {
-            self.set(k, i, *v);
-        }
-        Ok(())
+        self.commit_column(op, i, &col)
     }
 
     #[inline(always)]
@@ -356,6 +334,24 @@ impl<const N: usize> Cov<N> {
                 }
             }
         }
+    }
+
+    /// Writes row and column `j` from `col` if every entry is finite; otherwise Σ is left
+    /// untouched and the first overflowing entry is reported.
+    #[inline(always)]
+    fn commit_column(&mut self, op: &str, j: usize, col: &[f64; N]) -> Result<(), CovError> {
+        if let Some(k) = col.iter().position(|v| !v.is_finite()) {
+            return Err(CovError::Overflow {
+                operator: op.into(),
+                row: k.min(j),
+                col: k.max(j),
+                value: col[k],
+            });
+        }
+        for (k, v) in col.iter().enumerate() {
+            self.set(k, j, *v);
+        }
+        Ok(())
     }
 
     /// Checks the result of a kernel; on overflow restores the input and reports.
