@@ -276,15 +276,20 @@ mod tests {
         a
     }
 
-    #[test]
-    fn eigen_matches_nalgebra() {
-        let mut seed = 12345u64;
-        let mut rnd = || {
+    /// A seeded linear congruential generator of numbers in [0, 1).
+    fn uniform(mut seed: u64) -> impl FnMut() -> f64 {
+        move || {
             seed = seed
                 .wrapping_mul(6364136223846793005)
                 .wrapping_add(1442695040888963407);
-            ((seed >> 11) as f64 / (1u64 << 53) as f64) * 2.0 - 1.0
-        };
+            (seed >> 11) as f64 / (1u64 << 53) as f64
+        }
+    }
+
+    #[test]
+    fn eigen_matches_nalgebra() {
+        let mut lcg = uniform(12345);
+        let mut rnd = || lcg() * 2.0 - 1.0;
         for n in 1..=5 {
             for _ in 0..50 {
                 let l = DMatrix::from_fn(n, n, |_, _| rnd());
@@ -373,13 +378,8 @@ mod tests {
     /// matrices of every size, full rank or not.
     #[test]
     fn psd_det_matches_the_eigenvalues() {
-        let mut seed = 12345u64;
-        let mut next = || {
-            seed = seed
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            (seed >> 11) as f64 / (1u64 << 53) as f64 - 0.5
-        };
+        let mut lcg = uniform(12345);
+        let mut next = || lcg() - 0.5;
         for k in 1..=5 {
             for rank in 1..=k {
                 let g: Vec<Vec<f64>> = (0..k).map(|_| (0..rank).map(|_| next()).collect()).collect();

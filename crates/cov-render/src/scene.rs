@@ -93,16 +93,21 @@ pub struct V3(pub [f64; 3]);
 
 impl<'de> Deserialize<'de> for V3 {
     fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
-        let v = <(f64, f64, f64)>::deserialize(d)?;
-        let a = [v.0, v.1, v.2];
-        if a.iter().all(|x| x.is_finite()) {
-            Ok(V3(a))
-        } else {
-            Err(D::Error::custom(format!(
-                "a vector must be finite, got ({}, {}, {})",
-                v.0, v.1, v.2
-            )))
-        }
+        triple(d, |x| x.is_finite(), "a vector must be finite").map(V3)
+    }
+}
+
+/// Reads `(a, b, c)` whose every entry passes `ok`, else the error `what, got (a, b, c)`.
+fn triple<'de, D: Deserializer<'de>>(
+    d: D,
+    ok: impl Fn(f64) -> bool,
+    what: &str,
+) -> Result<[f64; 3], D::Error> {
+    let (a, b, c) = <(f64, f64, f64)>::deserialize(d)?;
+    if [a, b, c].into_iter().all(ok) {
+        Ok([a, b, c])
+    } else {
+        Err(D::Error::custom(format!("{what}, got ({a}, {b}, {c})")))
     }
 }
 
@@ -112,16 +117,12 @@ pub struct Rgb(pub [f64; 3]);
 
 impl<'de> Deserialize<'de> for Rgb {
     fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
-        let v = <(f64, f64, f64)>::deserialize(d)?;
-        let a = [v.0, v.1, v.2];
-        if a.iter().all(|x| x.is_finite() && *x >= 0.0) {
-            Ok(Rgb(a))
-        } else {
-            Err(D::Error::custom(format!(
-                "a colour must be finite and ≥ 0, got ({}, {}, {})",
-                v.0, v.1, v.2
-            )))
-        }
+        triple(
+            d,
+            |x| x.is_finite() && x >= 0.0,
+            "a colour must be finite and ≥ 0",
+        )
+        .map(Rgb)
     }
 }
 
