@@ -42,15 +42,12 @@
 //! [`Form`]: the square-root [`CovFactor`] (`Σ = L Lᵀ`, the default; PSD by construction,
 //! and a cancelling Schur complement loses `ε·√(Σ_big/Σ_small)` instead of
 //! `ε·Σ_big/Σ_small`: 2.4e-12 against 4.1e-9 on the stiff suite's 10⁴-operator bounce
-//! chains) or the covariance [`Cov`] itself (cheaper kernels). The covariance form sets a
-//! diagonal entry that cancelled to [`SCHUR_SNAP`] of its value to 0 with its row (f64
-//! cannot resolve it there): this errs towards a smaller bandwidth, and it is exact only
-//! when the true value is 0. The square-root form has no such snap on a lobe or an
-//! integration: Potter's update is a reflection and an exact column scaling, so a small
-//! variance that is well determined by the parameters (a 1e-9 m window refocused by a
-//! lobe) keeps 1e-18 accuracy where the covariance form loses 2.4e-4 to 8.6e-3 (stiff
-//! suite); only the reflection's own rounding (below 6.2e-15 of a row) is dropped.
-//! [`ROW_SNAP`] remains for correlated lobes (the array algorithm).
+//! chains) or the covariance [`Cov`] itself (cheaper kernels). Both make the same rank
+//! decisions ([`SCHUR_SNAP`] on Σ, [`ROW_SNAP`] `= √SCHUR_SNAP` on the factor's rows): an
+//! entry or row that cancelled below it is set to 0, which errs towards a smaller
+//! bandwidth and is exact only when the true value is 0. A small variance well determined
+//! by the parameters but not by Σ's entries (a 1e-9 m window refocused by a lobe) is lost
+//! in both forms today (2.4e-4 to 8.6e-3 relative, stiff suite).
 //!
 //! ```
 //! use cov_core::{Axis, Cov, CovError, Spectrum};

@@ -25,10 +25,9 @@ use crate::form::cov::{SCHUR_SNAP, layout_mismatch};
 use crate::linalg::{MAX, Small, sym_eigen};
 use crate::{AnyCov, AnySpectrum, Cov, CovError, Form, Spectrum};
 
-/// The factor's rank decision after a correlated lobe (the array algorithm; a diagonal
-/// lobe or an integration uses Potter's update, which needs no snap), on row norms
-/// (dimensionless): a row whose norm fell to at most `ROW_SNAP ×` its norm before holds
-/// rounding only and becomes exactly 0. `ROW_SNAP = √SCHUR_SNAP ≈ 1.2e-7`, so `Σ_aa` itself fell to at most
+/// The factor's rank decision after a Schur update, on row norms (dimensionless): a row
+/// whose norm fell to at most `ROW_SNAP ×` its norm before holds rounding only and becomes
+/// exactly 0. `ROW_SNAP = √SCHUR_SNAP ≈ 1.2e-7`, so `Σ_aa` itself fell to at most
 /// [`SCHUR_SNAP`] of its value: the same decision as the covariance form, in Σ terms.
 /// A finer threshold (`64 ε` on the row) was measured to keep accumulated rounding of
 /// 67 ε as "content", and a later integration along that noise removed 99.9995% of an
@@ -305,9 +304,6 @@ impl<const N: usize> Spectrum for CovFactor<N> {
     /// A column `√w e_i` is appended and the factor folded back.
     #[inline]
     fn raw_add_variance(&mut self, op: &str, i: usize, w: f64) -> Result<(), CovError> {
-        if let Some(order) = self.triangular_order() {
-            return self.commit(op, self.rank_one_triangular(&order, i, w.sqrt()));
-        }
         let mut m = self.work();
         m[i][N] = w.sqrt();
         self.fold(op, m, N + 1)
@@ -346,56 +342,6 @@ impl<const N: usize> CovFactor<N> {
             l[i].copy_from_slice(&self.l[i][..M]);
         }
         Some(CovFactor { l })
-    }
-
-    /// A row order in which the factor is lower triangular (row `order[j]` has no entry
-    /// beyond column `j`), if there is one: every fold leaves the factor triangular and a
-    /// pivoted Cholesky factor is triangular in its pivot order.
-    #[inline]
-    fn triangular_order(&self) -> Option<[usize; N]> {
-        // Rows by their last non-zero column (−1 for a zero row), ascending.
-        let mut last = [0i64; N];
-        for (r, row) in self.l.iter().enumerate() {
-            last[r] = row.iter().rposition(|v| *v != 0.0).map_or(-1, |c| c as i64);
-        }
-        let mut order = [0usize; N];
-        for (j, o) in order.iter_mut().enumerate() {
-            *o = j;
-        }
-        order.sort_unstable_by_key(|&r| (last[r], r));
-        order
-            .iter()
-            .enumerate()
-            .all(|(j, &r)| last[r] <= j as i64)
-            .then_some(order)
-    }
-
-    /// `L'` with `L' L'ᵀ = L Lᵀ + x xᵀ` for `x = a e_i`, for a factor lower triangular in
-    /// the row order `order`: Givens rotations of column `k` with `x`, for `k` from the
-    /// position of row `i` on, each zeroing `x` at row `order[k]` (rows before it are zero
-    /// in both), so `L'` stays triangular in that order. The same orthogonal fold as
-    /// [`Self::fold`]'s reflections, in `O(N²)` instead of `O(N³)`; a zero column (a
-    /// rank-deficient Σ) takes `x` exactly (`c = 0, s = ±1`).
-    #[inline]
-    fn rank_one_triangular(&self, order: &[usize; N], i: usize, a: f64) -> [[f64; N]; N] {
-        let mut new = self.l;
-        let mut x = [0.0; N];
-        x[i] = a;
-        let start = order.iter().position(|&r| r == i).unwrap_or(0);
-        for k in start..N {
-            let (d, b) = (new[order[k]][k], x[order[k]]);
-            if b == 0.0 {
-                continue;
-            }
-            let r = d.hypot(b);
-            let (c, s) = (d / r, b / r);
-            for &row in &order[k..] {
-                let (lj, xj) = (new[row][k], x[row]);
-                new[row][k] = c * lj + s * xj;
-                x[row] = c * xj - s * lj;
-            }
-        }
-        new
     }
 
     /// The factor in a work array, columns `0..N`.
@@ -476,84 +422,60 @@ impl<const N: usize> CovFactor<N> {
     }
 }
 
-/// Relative size (in row norm) of the rounding a reflection leaves in the columns it
-/// empties: a Householder reflection of a row `r` is exact to about `(2N + 4) ε |r|`
-/// (its backward error); `N = 5` gives 3.1e-15. Twice that is the limit below which what a
-/// row keeps outside the lobe's column is rounding, not content (measured on exactly
-/// proportional rows: at most 3.7e-16 over 20,000 random rows, the test below).
-const REFLECT_NOISE: f64 = 2.0 * (2.0 * MAX as f64 + 4.0) * f64::EPSILON;
-
-/// Potter's square-root update for a lobe on axis `p` with spectrum variance `s ≥ 0`,
-/// `Σ' = Σ − Σ e_p e_pᵀ Σ/(s + Σ_pp)`, done without cancellation: a Householder
-/// reflection from the right turns row `p` (`a = L_pᵀ`) into `σ e_c` (`|σ| = |a|`,
-/// `c` its largest entry), which leaves `L Lᵀ` unchanged; the update is then exactly
-/// the scaling of column `c` by `√(s/(s + |a|²))` (`I − a aᵀ/m` in the reflected frame is
-/// `diag(1, …, s/m, …, 1)`). What each row holds along `a` is scaled, what it holds
-/// across `a` is kept as it was: a ray refocused onto a point keeps its exact small
-/// variance instead of the difference of two large ones. Returns the column `c` (`None`
-/// when row `p` is zero: no content along `p`, nothing to remove).
+/// Potter's square-root update for a lobe on axis `p` with spectrum variance `s ≥ 0`:
+/// with `a = L_pᵀ` (row `p`) and `m = s + |a|²`, `L' = L (I − γ a aᵀ)`,
+/// `γ = 1/(m + √(s m))`, which squares to `I − a aᵀ/m`, i.e.
+/// `Σ' = Σ − Σ e_p e_pᵀ Σ/(s + Σ_pp)`. `γ` has no cancellation, and row `p` becomes
+/// exactly `L_p √(s/m)` (the covariance form's `Σ_pp s/m`, to relative accuracy; exactly
+/// 0 for a diffuse lobe). When `|a|² + s` would overflow or underflow, `a` and `s` are
+/// scaled by `max(|a_i|, √s)` first.
 #[inline]
-fn potter<const N: usize>(l: &mut [[f64; N]; N], p: usize, s: f64) -> Option<usize> {
-    let a = l[p];
-    let na = row_norm(&a);
-    if na == 0.0 || !na.is_finite() {
-        return None;
+fn potter<const N: usize>(l: &mut [[f64; N]; N], p: usize, s: f64) {
+    let mut a = l[p];
+    let mut sh = s;
+    let mut mh = s + a.iter().map(|v| v * v).sum::<f64>();
+    if !(mh.is_finite() && mh > 1e-290) {
+        let scale = a.iter().fold(s.sqrt(), |m, v| m.max(v.abs()));
+        if scale == 0.0 || !scale.is_finite() {
+            // No content along p and a diffuse lobe: nothing to remove.
+            return;
+        }
+        let inv = 1.0 / scale;
+        for v in a.iter_mut() {
+            *v *= inv;
+        }
+        sh = (s * inv) * inv;
+        mh = sh + a.iter().map(|v| v * v).sum::<f64>();
     }
-    let c = (0..N).fold(0, |best, k| if a[k].abs() > a[best].abs() { k } else { best });
-    // v = (a − σ e_c)/|a| with σ = −sign(a_c)|a|: no cancellation in v_c.
-    let sigma = if a[c] >= 0.0 { -na } else { na };
-    let mut v = [0.0; N];
-    for k in 0..N {
-        v[k] = a[k] / na;
-    }
-    v[c] -= sigma / na;
-    let vv: f64 = v.iter().map(|x| x * x).sum();
-    let beta = 2.0 / vv;
+    let gamma = 1.0 / (mh + (sh * mh).sqrt());
+    let keep = (sh / mh).sqrt();
     for (i, row) in l.iter_mut().enumerate() {
         if i == p {
-            *row = [0.0; N];
-            row[c] = sigma;
+            for v in row.iter_mut() {
+                *v *= keep;
+            }
             continue;
         }
-        let g = beta * row.iter().zip(&v).map(|(x, y)| x * y).sum::<f64>();
-        for (x, y) in row.iter_mut().zip(&v) {
-            *x -= g * y;
+        let g = gamma * row.iter().zip(&a).map(|(x, y)| x * y).sum::<f64>();
+        for (v, ac) in row.iter_mut().zip(&a) {
+            *v -= g * ac;
         }
     }
-    // keep = √(s/(s + |a|²)) = √(t/(t + 1)) with t = s/|a|², in range for any scale.
-    let t = (s / na) / na;
-    let keep = if t.is_infinite() {
-        1.0
-    } else {
-        (t / (t + 1.0)).sqrt()
-    };
-    for row in l.iter_mut() {
-        row[c] *= keep;
-    }
-    Some(c)
 }
 
-/// [`potter`] along axis `p`, then the clean-up: what a row holds outside the lobe's
-/// column `c` after the reflection, when at most [`REFLECT_NOISE`] of the row's norm
-/// before, is the reflection's rounding (the row was proportional to row `p`) and becomes
-/// exactly 0; the row's part along `c`, which the update scaled exactly, is kept. The
-/// clean-up runs after every axis, so that a later axis never updates along rounding (an
-/// update along noise would remove a random part of every other row).
+/// [`potter`] along axis `p`, then the clean-up: a row whose norm fell to at most
+/// [`ROW_SNAP`] of its norm before is rounding noise (the covariance form's decision, in
+/// Σ terms) and becomes exactly 0. Row `p` is exempt: Potter scales it, so a large drop is
+/// the lobe's information. The clean-up runs after every axis, so that a later axis never
+/// updates along a noise direction (a zero-`s` update along noise would remove a random
+/// part of every other row).
 #[inline]
 fn potter_axis<const N: usize>(l: &mut [[f64; N]; N], p: usize, s: f64) {
     let old = *l;
-    let Some(c) = potter(l, p, s) else { return };
+    potter(l, p, s);
     for i in 0..N {
-        if i == p {
-            continue;
-        }
-        let before = row_norm(&old[i]);
-        let mut rest = l[i];
-        rest[c] = 0.0;
-        if before > 0.0 && row_norm(&rest) <= REFLECT_NOISE * before {
-            let kept = l[i][c];
+        if i != p && cancelled(&l[i], &old[i]) {
             l[i] = [0.0; N];
-            l[i][c] = kept;
         }
     }
 }
@@ -656,48 +578,4 @@ fn psd_factor(k: usize, s: &Small) -> Small {
         }
     }
     f
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    /// The rounding a reflection leaves outside the lobe's column, on rows that are
-    /// exactly proportional to the lobe's row (their true remainder is 0), over random
-    /// rows of 2 to 5 entries spanning 12 decades: below half of [`REFLECT_NOISE`].
-    #[test]
-    fn reflection_rounding_is_below_the_noise_limit() {
-        let mut seed = 0x2545_f491_4f6c_dd1du64;
-        let mut next = || {
-            seed ^= seed << 13;
-            seed ^= seed >> 7;
-            seed ^= seed << 17;
-            (seed >> 11) as f64 / (1u64 << 53) as f64
-        };
-        let mut worst: f64 = 0.0;
-        for _ in 0..20_000 {
-            let mut a = [0.0; 5];
-            for v in a.iter_mut() {
-                *v = (next() - 0.5) * 10f64.powf(12.0 * next() - 6.0);
-            }
-            let k = 2.0 * next() - 1.0;
-            // Row 0 is the lobe's row, row 1 = k · row 0 (exactly, up to rounding of k·a).
-            let mut l = [[0.0; 5]; 5];
-            l[0] = a;
-            for c in 0..5 {
-                l[1][c] = k * a[c];
-            }
-            let before = row_norm(&l[1]);
-            let Some(c) = potter(&mut l, 0, next()) else {
-                continue;
-            };
-            let mut rest = l[1];
-            rest[c] = 0.0;
-            if before > 0.0 {
-                worst = worst.max(row_norm(&rest) / before);
-            }
-        }
-        println!("worst remainder / row norm: {worst:e} (limit {REFLECT_NOISE:e})");
-        assert!(worst <= 0.5 * REFLECT_NOISE, "{worst:e}");
-    }
 }
