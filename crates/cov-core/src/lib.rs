@@ -74,6 +74,7 @@ mod query;
 mod report;
 pub mod spec;
 mod spectrum;
+mod tape;
 
 pub use any::{AnyCov, AnyFactor, AnySpectrum};
 pub use axis::{Axis, AxisSet, axis_index, layout_axes, layout_set};
@@ -85,7 +86,8 @@ pub use operator::{Chain, Operator, Step, Trace, check_layout};
 pub use query::{CovBlock, Filter, NYQUIST_K, primal_std_of_spectrum};
 pub use report::{Field, Report, ReportField};
 pub use spec::{OperatorReader, OperatorSpec, Param, Registrar};
-pub use spectrum::{Form, Spectrum, transverse_pairs};
+pub use spectrum::{Concrete, Form, Spectrum, transverse_pairs};
+pub use tape::{Block, Kernel, Recorder, Tape};
 
 /// serde, for the code `#[derive(OperatorSpec)]` generates.
 #[doc(hidden)]

@@ -1,9 +1,13 @@
 //! The [`Operator`] trait and [`Chain`]s of operators (light paths).
 
 use std::fmt;
-use std::sync::Arc;
+use std::sync::atomic::{AtomicU32, Ordering};
+use std::sync::{Arc, OnceLock};
 
-use crate::{AnyCov, AnySpectrum, AxisSet, Cov, CovError, Form, Report, Spectrum, layout_set};
+use crate::form::Kernels;
+use crate::{
+    AnyCov, AnySpectrum, AxisSet, Concrete, Cov, CovError, Form, Report, Spectrum, Tape, layout_set,
+};
 
 /// An event on a light path, acting on the spectrum covariance.
 ///
@@ -110,6 +114,16 @@ fn short_type_name(full: &'static str) -> &'static str {
 #[derive(Clone, Debug, Default)]
 pub struct Chain {
     steps: Vec<Arc<dyn Operator>>,
+    /// Compiled tapes, one per (layout, form), built on the second evaluation in that
+    /// layout and form (a chain evaluated once, as a renderer's per-path chain is, is not
+    /// worth recording). Shared by clones; reset by every change of the steps.
+    compiled: Arc<Compiled>,
+}
+
+#[derive(Debug, Default)]
+struct Compiled {
+    tapes: [OnceLock<Tape>; 8],
+    uses: [AtomicU32; 8],
 }
 
 /// One recorded step of a [`Chain::trace`].
@@ -150,17 +164,81 @@ impl Trace {
 impl Chain {
     /// An empty chain (the identity).
     pub fn new() -> Self {
-        Chain { steps: Vec::new() }
+        Chain::default()
     }
 
     /// Appends an operator.
     pub fn push(&mut self, op: impl Operator + 'static) {
-        self.steps.push(Arc::new(op));
+        self.push_shared(Arc::new(op));
     }
 
     /// Appends a shared operator.
     pub fn push_shared(&mut self, op: Arc<dyn Operator>) {
         self.steps.push(op);
+        self.compiled = Arc::default();
+    }
+
+    /// The chain compiled for layout `dim` and `form`: the kernel calls of every step
+    /// with axes resolved and parameters checked ([`Tape`]). Steps that read Σ stay
+    /// opaque. [`Chain::eval`] and the other evaluations compile on their own (from the
+    /// second evaluation in a layout and form on); this is for inspection and for
+    /// [`Tape::run_cov`].
+    ///
+    /// # Errors
+    /// [`CovError::Shape`] for a layout size outside 2..=5.
+    pub fn compile(&self, dim: usize, form: Form) -> Result<Tape, CovError> {
+        let mut tape = Tape::new(dim, form)?;
+        for op in &self.steps {
+            tape.push_shared(op);
+        }
+        Ok(tape)
+    }
+
+    /// The cached tape of layout `K::DIM` and form `K::FORM`, once the chain has been
+    /// evaluated there before (`None` on a first evaluation).
+    fn tape<K: Kernels>(&self) -> Option<&Tape> {
+        let slot = (K::DIM - 2) * 2 + usize::from(K::FORM == Form::SquareRoot);
+        let c = &self.compiled;
+        if let Some(t) = c.tapes[slot].get() {
+            return Some(t);
+        }
+        if c.uses[slot].fetch_add(1, Ordering::Relaxed) == 0 {
+            return None;
+        }
+        Some(c.tapes[slot].get_or_init(|| {
+            let mut tape = Tape::empty(K::DIM, K::FORM);
+            for op in &self.steps {
+                tape.push_shared(op);
+            }
+            tape
+        }))
+    }
+
+    /// The fast path on a concrete form: the compiled tape on a copy of Σ, committed if
+    /// it ran clean; otherwise (or on a first evaluation) the checked path, which finds
+    /// and reports the failing step and leaves Σ as it was.
+    fn apply_fast<K: Kernels>(&self, k: &mut K) -> Result<(), CovError> {
+        if let Some(tape) = self.tape::<K>() {
+            let mut work = *k;
+            if tape.run(&mut work) {
+                *k = work;
+                return Ok(());
+            }
+        }
+        self.apply_checked(k)
+    }
+
+    /// Every step with its checks: parameters, axes, the kernels' overflow checks and a
+    /// finiteness check after each step; Σ is restored to its start on error.
+    fn apply_checked(&self, cov: &mut dyn Spectrum) -> Result<(), CovError> {
+        let start = cov.snapshot();
+        for (index, op) in self.steps.iter().enumerate() {
+            if let Err(e) = apply_step(index, op.as_ref(), cov) {
+                cov.restore(&start);
+                return Err(e);
+            }
+        }
+        Ok(())
     }
 
     /// Builder form of [`Chain::push`].
@@ -292,15 +370,28 @@ fn apply_step(index: usize, op: &dyn Operator, c: &mut dyn Spectrum) -> Result<(
 }
 
 impl Operator for Chain {
+    /// On `Cov<N>` and `CovFactor<N>` this runs the compiled tape ([`Chain::compile`])
+    /// and falls back to the checked steps only if the tape's result is not finite, so
+    /// errors name the same step, operator and value as the checked path; Σ is left as
+    /// it was on error. Other spectra take the checked path.
     fn apply(&self, cov: &mut dyn Spectrum) -> Result<(), CovError> {
-        let start = cov.snapshot();
-        for (index, op) in self.steps.iter().enumerate() {
-            if let Err(e) = apply_step(index, op.as_ref(), cov) {
-                cov.restore(&start);
-                return Err(e);
+        match cov.concrete() {
+            Concrete::Cov2(c) => self.apply_fast(c),
+            Concrete::Cov3(c) => self.apply_fast(c),
+            Concrete::Cov4(c) => self.apply_fast(c),
+            Concrete::Cov5(c) => self.apply_fast(c),
+            Concrete::Factor2(f) => self.apply_fast(f),
+            Concrete::Factor3(f) => self.apply_fast(f),
+            Concrete::Factor4(f) => self.apply_fast(f),
+            Concrete::Factor5(f) => self.apply_fast(f),
+            Concrete::Tape(tape) => {
+                for op in &self.steps {
+                    tape.push_shared(op);
+                }
+                Ok(())
             }
+            Concrete::Other => self.apply_checked(cov),
         }
-        Ok(())
     }
 
     fn name(&self) -> &str {

@@ -12,7 +12,7 @@ use std::fmt;
 
 use crate::axis::{axis_index, layout_axes};
 use crate::linalg::{MAX, Small, sym_eigen};
-use crate::{AnyCov, AnySpectrum, Axis, CovError, PSD_RTOL};
+use crate::{AnyCov, AnySpectrum, Axis, Cov, CovError, CovFactor, PSD_RTOL};
 
 /// How a chain holds Σ while it is evaluated.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize)]
@@ -78,6 +78,13 @@ pub trait Spectrum: fmt::Debug {
     fn restore(&mut self, s: &AnySpectrum);
     /// The first stored number that is not finite, as (row, column, value), if any.
     fn first_non_finite(&self) -> Option<(usize, usize, f64)>;
+
+    /// The concrete form behind this trait object, so that a [`crate::Chain`] can run its
+    /// compiled fast path ([`crate::Tape`]) on it. Default: [`Concrete::Other`], which
+    /// takes the checked path (a third-party `Spectrum` needs nothing more).
+    fn concrete(&mut self) -> Concrete<'_> {
+        Concrete::Other
+    }
 
     // ---- raw kernels: indices resolved, parameters checked -----------------------
 
@@ -324,6 +331,33 @@ pub trait Spectrum: fmt::Debug {
         let (idx, k) = resolve(self.dim(), "integrate", axes)?;
         self.raw_lobe("integrate", &idx[..k], &[[0.0; MAX]; MAX])
     }
+}
+
+/// What a `&mut dyn Spectrum` holds ([`Spectrum::concrete`]): one of the two forms in one
+/// of the four layouts, the tape of a recorder, or something else.
+#[derive(Debug)]
+pub enum Concrete<'a> {
+    /// `Cov<2>`.
+    Cov2(&'a mut Cov<2>),
+    /// `Cov<3>`.
+    Cov3(&'a mut Cov<3>),
+    /// `Cov<4>`.
+    Cov4(&'a mut Cov<4>),
+    /// `Cov<5>`.
+    Cov5(&'a mut Cov<5>),
+    /// `CovFactor<2>`.
+    Factor2(&'a mut CovFactor<2>),
+    /// `CovFactor<3>`.
+    Factor3(&'a mut CovFactor<3>),
+    /// `CovFactor<4>`.
+    Factor4(&'a mut CovFactor<4>),
+    /// `CovFactor<5>`.
+    Factor5(&'a mut CovFactor<5>),
+    /// The tape of a [`crate::Recorder`]: a chain nested in a recorded chain records its steps
+    /// one by one ([`crate::Tape::push_shared`]).
+    Tape(&'a mut crate::Tape),
+    /// Any other implementation.
+    Other,
 }
 
 /// The (position, direction) pairs of layout `n` (see [`Spectrum::transverse_pairs`]).

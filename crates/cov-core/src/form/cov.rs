@@ -3,6 +3,7 @@
 //! in place, keeps Σ exactly symmetric (packed storage) and restores Σ on overflow. Each
 //! is tested against a dense nalgebra reference (`tests/kernels.rs`).
 
+use super::Kernels;
 use crate::linalg::{MAX, Small, psd_pinv};
 use crate::{AnyCov, AnySpectrum, Cov, CovError, Form, Spectrum};
 
@@ -55,47 +56,27 @@ impl<const N: usize> Spectrum for Cov<N> {
     fn first_non_finite(&self) -> Option<(usize, usize, f64)> {
         super::overflow_at(self.check_finite(""))
     }
+    fn concrete(&mut self) -> crate::Concrete<'_> {
+        crate::tape::concrete_cov(self)
+    }
 
     fn raw_congruence(&mut self, op: &str, a: &Small) -> Result<(), CovError> {
-        // B = Σ A, then Σ'_ij = Σ_k A_ki B_kj for i ≤ j only (exact symmetry).
-        let mut b = [[0.0; N]; N];
-        for (k, row) in b.iter_mut().enumerate() {
-            for (j, v) in row.iter_mut().enumerate() {
-                *v = (0..N).map(|l| self.get(k, l) * a[l][j]).sum();
-            }
-        }
         let old = *self;
-        for i in 0..N {
-            for j in i..N {
-                let v: f64 = (0..N).map(|k| a[k][i] * b[k][j]).sum();
-                // A diagonal is the quadratic form a_iᵀ Σ a_i ≥ 0 (see `quadratic`).
-                self.set(i, j, if i == j { quadratic(v) } else { v });
-            }
-        }
+        self.congruence_in_place(a);
         self.finish(op, old)
     }
 
     #[inline(always)]
     fn raw_shear(&mut self, op: &str, i: usize, j: usize, s: f64) -> Result<(), CovError> {
         // Compute the new column j, check it, then commit: Σ is untouched on overflow.
-        let mut col = [0.0; N];
-        for (k, c) in col.iter_mut().enumerate() {
-            *c = if k == j {
-                quadratic(self.get(j, j) + s * (2.0 * self.get(i, j) + s * self.get(i, i)))
-            } else {
-                self.get(k, j) + s * self.get(k, i)
-            };
-        }
+        let col = self.shear_col(i, j, s);
         self.commit_column(op, j, &col)
     }
 
     #[inline(always)]
     fn raw_scale(&mut self, op: &str, i: usize, c: f64) -> Result<(), CovError> {
         // The new row/column i, checked before it is written: Σ is untouched on overflow.
-        let mut col = [0.0; N];
-        for (k, v) in col.iter_mut().enumerate() {
-            *v = self.get(k, i) * if k == i { c * c } else { c };
-        }
+        let col = self.scale_col(i, c);
         self.commit_column(op, i, &col)
     }
 
@@ -121,12 +102,7 @@ impl<const N: usize> Spectrum for Cov<N> {
     #[inline]
     fn raw_add_window(&mut self, op: &str, p: &[usize], w: &Small) -> Result<(), CovError> {
         let old = *self;
-        for a in 0..p.len() {
-            for b in a..p.len() {
-                let v = self.get(p[a], p[b]) + w[a][b];
-                self.set(p[a], p[b], v);
-            }
-        }
+        self.add_window_in_place(p, w);
         self.finish(op, old)
     }
 
@@ -161,16 +137,63 @@ impl<const N: usize> Spectrum for Cov<N> {
     #[inline]
     fn raw_lobe(&mut self, op: &str, p: &[usize], s: &Small) -> Result<(), CovError> {
         let old = *self;
-        if let [p1] = p {
-            self.lobe_product_1(*p1, s[0][0]);
-        } else {
-            self.lobe_product(p, s);
-        }
+        self.lobe_in_place(p, s);
         self.finish(op, old)
     }
 }
 
-/// The error of a Σ handed to a spectrum of another layout.
+impl<const N: usize> Kernels for Cov<N> {
+    const FORM: Form = Form::Covariance;
+    const DIM: usize = N;
+
+    #[inline(always)]
+    fn k_shear(&mut self, i: usize, j: usize, s: f64) {
+        let col = self.shear_col(i, j, s);
+        for (k, v) in col.iter().enumerate() {
+            self.set(k, j, *v);
+        }
+    }
+    #[inline(always)]
+    fn k_scale(&mut self, i: usize, c: f64) {
+        let col = self.scale_col(i, c);
+        for (k, v) in col.iter().enumerate() {
+            self.set(k, i, *v);
+        }
+    }
+    #[inline(always)]
+    fn k_rotate(&mut self, i: usize, j: usize, c: f64, s: f64) {
+        self.rotate_idx(i, j, c, s);
+    }
+    #[inline(always)]
+    fn k_add_variance(&mut self, i: usize, w: f64) {
+        let v = self.get(i, i) + w;
+        self.set(i, i, v);
+    }
+    #[inline(always)]
+    fn k_lobe_1(&mut self, p: usize, s: f64) {
+        self.lobe_product_1(p, s);
+    }
+    fn k_add_window(&mut self, p: &[usize], w: &Small) {
+        self.add_window_in_place(p, w);
+    }
+    fn k_lobe(&mut self, p: &[usize], s: &Small) {
+        self.lobe_in_place(p, s);
+    }
+    fn k_congruence(&mut self, a: &Small) {
+        self.congruence_in_place(a);
+    }
+    #[inline(always)]
+    fn all_finite(&self) -> bool {
+        // A branch-free OR over the packed entries (it vectorises).
+        let mut bad = false;
+        for v in self.packed() {
+            bad |= !v.is_finite();
+        }
+        !bad
+    }
+}
+
+/// The error of a Σ handed/// The error of a Σ handed to a spectrum of another layout.
 pub(crate) fn layout_mismatch(have: usize, got: usize) -> CovError {
     CovError::Shape {
         what: "Spectrum::assign".into(),
@@ -180,6 +203,67 @@ pub(crate) fn layout_mismatch(have: usize, got: usize) -> CovError {
 }
 
 impl<const N: usize> Cov<N> {
+    /// Column `j` after the shear `z'_i = z_i + s·z_j` (indices as in `raw_shear`).
+    #[inline(always)]
+    fn shear_col(&self, i: usize, j: usize, s: f64) -> [f64; N] {
+        let mut col = [0.0; N];
+        for (k, c) in col.iter_mut().enumerate() {
+            *c = if k == j {
+                quadratic(self.get(j, j) + s * (2.0 * self.get(i, j) + s * self.get(i, i)))
+            } else {
+                self.get(k, j) + s * self.get(k, i)
+            };
+        }
+        col
+    }
+
+    /// Column `i` after scaling axis `i` by `c`.
+    #[inline(always)]
+    fn scale_col(&self, i: usize, c: f64) -> [f64; N] {
+        let mut col = [0.0; N];
+        for (k, v) in col.iter_mut().enumerate() {
+            *v = self.get(k, i) * if k == i { c * c } else { c };
+        }
+        col
+    }
+
+    /// `Σ ← Aᵀ Σ A`: `B = Σ A`, then `Σ'_ij = Σ_k A_ki B_kj` for `i ≤ j` only (exact
+    /// symmetry).
+    fn congruence_in_place(&mut self, a: &Small) {
+        let mut b = [[0.0; N]; N];
+        for (k, row) in b.iter_mut().enumerate() {
+            for (j, v) in row.iter_mut().enumerate() {
+                *v = (0..N).map(|l| self.get(k, l) * a[l][j]).sum();
+            }
+        }
+        for i in 0..N {
+            for j in i..N {
+                let v: f64 = (0..N).map(|k| a[k][i] * b[k][j]).sum();
+                // A diagonal is the quadratic form a_iᵀ Σ a_i ≥ 0 (see `quadratic`).
+                self.set(i, j, if i == j { quadratic(v) } else { v });
+            }
+        }
+    }
+
+    /// `Σ_pp += W`.
+    fn add_window_in_place(&mut self, p: &[usize], w: &Small) {
+        for a in 0..p.len() {
+            for b in a..p.len() {
+                let v = self.get(p[a], p[b]) + w[a][b];
+                self.set(p[a], p[b], v);
+            }
+        }
+    }
+
+    /// Rule 3 along `p` (one axis or several).
+    fn lobe_in_place(&mut self, p: &[usize], s: &Small) {
+        if let [p1] = p {
+            self.lobe_product_1(*p1, s[0][0]);
+        } else {
+            self.lobe_product(p, s);
+        }
+    }
+
     #[inline(always)]
     fn rotate_idx(&mut self, i: usize, j: usize, c: f64, s: f64) {
         let sii = self.get(i, i);

@@ -21,6 +21,7 @@
 //!   inverted;
 //! - rule 4 is rule 3 with `S = 0`.
 
+use crate::form::Kernels;
 use crate::form::cov::{SCHUR_SNAP, layout_mismatch};
 use crate::linalg::{MAX, Small, sym_eigen};
 use crate::{AnyCov, AnySpectrum, Cov, CovError, Form, Spectrum};
@@ -211,6 +212,21 @@ impl<const N: usize> CovFactor<N> {
         Ok(())
     }
 
+    /// Writes row `i` if it is finite; otherwise the factor is untouched.
+    #[inline(always)]
+    fn commit_row(&mut self, op: &str, i: usize, row: [f64; N]) -> Result<(), CovError> {
+        if let Some(c) = row.iter().position(|v| !v.is_finite()) {
+            return Err(CovError::Overflow {
+                operator: op.into(),
+                row: i,
+                col: c,
+                value: row[c],
+            });
+        }
+        self.l[i] = row;
+        Ok(())
+    }
+
     fn commit(&mut self, op: &str, new: [[f64; N]; N]) -> Result<(), CovError> {
         let f = CovFactor { l: new };
         f.check_finite(op)?;
@@ -247,36 +263,34 @@ impl<const N: usize> Spectrum for CovFactor<N> {
     fn first_non_finite(&self) -> Option<(usize, usize, f64)> {
         super::overflow_at(self.check_finite(""))
     }
+    fn concrete(&mut self) -> crate::Concrete<'_> {
+        crate::tape::concrete_factor(self)
+    }
 
     /// `L' = Aᵀ L`.
     fn raw_congruence(&mut self, op: &str, a: &Small) -> Result<(), CovError> {
-        let mut new = [[0.0; N]; N];
-        for (i, row) in new.iter_mut().enumerate() {
-            for (c, v) in row.iter_mut().enumerate() {
-                *v = (0..N).map(|k| a[k][i] * self.l[k][c]).sum();
-            }
-        }
+        let new = self.congruence_new(a);
         self.commit(op, new)
     }
 
     /// Row `j` += `s ×` row `i`.
     #[inline]
     fn raw_shear(&mut self, op: &str, i: usize, j: usize, s: f64) -> Result<(), CovError> {
-        let mut new = self.l;
+        let mut row = self.l[j];
         for c in 0..N {
-            new[j][c] += s * self.l[i][c];
+            row[c] += s * self.l[i][c];
         }
-        self.commit(op, new)
+        self.commit_row(op, j, row)
     }
 
     /// Row `i` times `c`.
     #[inline]
     fn raw_scale(&mut self, op: &str, i: usize, c: f64) -> Result<(), CovError> {
-        let mut new = self.l;
-        for v in new[i].iter_mut() {
+        let mut row = self.l[i];
+        for v in row.iter_mut() {
             *v *= c;
         }
-        self.commit(op, new)
+        self.commit_row(op, i, row)
     }
 
     /// Rows rotated in each plane (an orthogonal map: it cannot overflow).
@@ -290,23 +304,15 @@ impl<const N: usize> Spectrum for CovFactor<N> {
 
     /// The columns of `W`'s factor are appended and the factor folded back.
     fn raw_add_window(&mut self, op: &str, p: &[usize], w: &Small) -> Result<(), CovError> {
-        let k = p.len();
-        let wf = psd_factor(k, w);
-        let mut m = self.work();
-        for a in 0..k {
-            for c in 0..k {
-                m[p[a]][N + c] = wf[a][c];
-            }
-        }
-        self.fold(op, m, N + k)
+        let new = self.add_window_new(p, w);
+        self.commit(op, new)
     }
 
     /// A column `√w e_i` is appended and the factor folded back.
     #[inline]
     fn raw_add_variance(&mut self, op: &str, i: usize, w: f64) -> Result<(), CovError> {
-        let mut m = self.work();
-        m[i][N] = w.sqrt();
-        self.fold(op, m, N + 1)
+        let new = self.add_variance_new(i, w);
+        self.commit(op, new)
     }
 
     /// Potter's update along one axis.
@@ -319,7 +325,57 @@ impl<const N: usize> Spectrum for CovFactor<N> {
 
     /// Rule 3 by Potter's update per axis (diagonal `S`) or the array algorithm.
     fn raw_lobe(&mut self, op: &str, p: &[usize], s: &Small) -> Result<(), CovError> {
-        self.lobe(op, p, s)
+        let new = self.lobe_new(p, s);
+        self.commit(op, new)
+    }
+}
+
+impl<const N: usize> Kernels for CovFactor<N> {
+    const FORM: Form = Form::SquareRoot;
+    const DIM: usize = N;
+
+    #[inline(always)]
+    fn k_shear(&mut self, i: usize, j: usize, s: f64) {
+        for c in 0..N {
+            self.l[j][c] += s * self.l[i][c];
+        }
+    }
+    #[inline(always)]
+    fn k_scale(&mut self, i: usize, c: f64) {
+        for v in self.l[i].iter_mut() {
+            *v *= c;
+        }
+    }
+    #[inline(always)]
+    fn k_rotate(&mut self, i: usize, j: usize, c: f64, s: f64) {
+        self.rotate_rows(i, j, c, s);
+    }
+    #[inline]
+    fn k_add_variance(&mut self, i: usize, w: f64) {
+        self.l = self.add_variance_new(i, w);
+    }
+    #[inline]
+    fn k_lobe_1(&mut self, p: usize, s: f64) {
+        potter_axis(&mut self.l, p, s.max(0.0));
+    }
+    fn k_add_window(&mut self, p: &[usize], w: &Small) {
+        self.l = self.add_window_new(p, w);
+    }
+    fn k_lobe(&mut self, p: &[usize], s: &Small) {
+        self.l = self.lobe_new(p, s);
+    }
+    fn k_congruence(&mut self, a: &Small) {
+        self.l = self.congruence_new(a);
+    }
+    #[inline(always)]
+    fn all_finite(&self) -> bool {
+        let mut bad = false;
+        for row in &self.l {
+            for v in row {
+                bad |= !v.is_finite();
+            }
+        }
+        !bad
     }
 }
 
@@ -357,7 +413,7 @@ impl<const N: usize> CovFactor<N> {
     /// `N` columns are non-zero (a rank-deficient Σ has free columns: a source constant
     /// along an axis, an integrated axis), they are only packed side by side, exactly;
     /// otherwise Householder reflections from the right triangularise `M`.
-    fn fold(&mut self, op: &str, mut m: Work, cols: usize) -> Result<(), CovError> {
+    fn fold_new(mut m: Work, cols: usize) -> [[f64; N]; N] {
         let mut used = [0usize; W];
         let mut n_used = 0;
         for c in 0..cols {
@@ -373,14 +429,46 @@ impl<const N: usize> CovFactor<N> {
                     new[i][to] = m[i][from];
                 }
             }
-            return self.commit(op, new);
+            return new;
         }
         lq(&mut m, 0, N, N, cols);
         let mut new = [[0.0; N]; N];
         for i in 0..N {
             new[i].copy_from_slice(&m[i][..N]);
         }
-        self.commit(op, new)
+        new
+    }
+
+    /// `L' = Aᵀ L`.
+    fn congruence_new(&self, a: &Small) -> [[f64; N]; N] {
+        let mut new = [[0.0; N]; N];
+        for (i, row) in new.iter_mut().enumerate() {
+            for (c, v) in row.iter_mut().enumerate() {
+                *v = (0..N).map(|k| a[k][i] * self.l[k][c]).sum();
+            }
+        }
+        new
+    }
+
+    /// The factor of `Σ + W` on the indices `p`.
+    fn add_window_new(&self, p: &[usize], w: &Small) -> [[f64; N]; N] {
+        let k = p.len();
+        let wf = psd_factor(k, w);
+        let mut m = self.work();
+        for a in 0..k {
+            for c in 0..k {
+                m[p[a]][N + c] = wf[a][c];
+            }
+        }
+        Self::fold_new(m, N + k)
+    }
+
+    /// The factor of `Σ + w e_i e_iᵀ`.
+    #[inline]
+    fn add_variance_new(&self, i: usize, w: f64) -> [[f64; N]; N] {
+        let mut m = self.work();
+        m[i][N] = w.sqrt();
+        Self::fold_new(m, N + 1)
     }
 
     /// Rule 3. A diagonal `S` (the usual lobe, and integration) is done as one-axis
@@ -389,7 +477,7 @@ impl<const N: usize> CovFactor<N> {
     /// `[[√S, P L], [0, L]]` is brought to `[[α, 0], [β, L']]` by Householder reflections
     /// from the right, so `α αᵀ = S + PΣPᵀ`, `β αᵀ = Σ Pᵀ` and `L' L'ᵀ` is the update;
     /// it mixes the factor's columns, never its rows (axes), and inverts nothing.
-    fn lobe(&mut self, op: &str, p: &[usize], s: &Small) -> Result<(), CovError> {
+    fn lobe_new(&self, p: &[usize], s: &Small) -> [[f64; N]; N] {
         let k = p.len();
         let diagonal = (0..k).all(|a| (0..k).all(|b| a == b || s[a][b] == 0.0));
         let mut new = self.l;
@@ -397,7 +485,7 @@ impl<const N: usize> CovFactor<N> {
             for a in 0..k {
                 potter_axis(&mut new, p[a], s[a][a].max(0.0));
             }
-            return self.commit(op, new);
+            return new;
         }
         let sf = psd_factor(k, s);
         let mut m = [[0.0; W]; W];
@@ -418,7 +506,7 @@ impl<const N: usize> CovFactor<N> {
                 new[i] = [0.0; N];
             }
         }
-        self.commit(op, new)
+        new
     }
 }
 

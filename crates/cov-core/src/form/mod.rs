@@ -15,3 +15,26 @@ pub(crate) fn overflow_at(check: Result<(), crate::CovError>) -> Option<(usize, 
         _ => (0, 0, f64::NAN),
     })
 }
+
+/// The unchecked in-place kernels of a concrete form, for compiled chains
+/// ([`crate::Tape`]). Indices are resolved and parameters checked when the tape is
+/// recorded; these kernels do not check their output: ∞ and NaN propagate, and the tape
+/// checks finiteness where a later kernel could hide them and at the end. Each computes
+/// exactly what the matching checked `raw_*` kernel of [`crate::Spectrum`] computes, so a
+/// compiled chain and a checked one give the same bits.
+pub(crate) trait Kernels: crate::Spectrum + Copy {
+    /// The form.
+    const FORM: crate::Form;
+    /// The layout size.
+    const DIM: usize;
+    fn k_shear(&mut self, i: usize, j: usize, s: f64);
+    fn k_scale(&mut self, i: usize, c: f64);
+    fn k_rotate(&mut self, i: usize, j: usize, c: f64, s: f64);
+    fn k_add_variance(&mut self, i: usize, w: f64);
+    fn k_lobe_1(&mut self, p: usize, s: f64);
+    fn k_add_window(&mut self, p: &[usize], w: &crate::linalg::Small);
+    fn k_lobe(&mut self, p: &[usize], s: &crate::linalg::Small);
+    fn k_congruence(&mut self, a: &crate::linalg::Small);
+    /// Whether every stored number is finite.
+    fn all_finite(&self) -> bool;
+}
