@@ -218,3 +218,73 @@ fn a_tape_refuses_another_layout_or_form() {
     t.push_shared(&shared);
     assert!(matches!(t.kernels(), [Kernel::Opaque(_)]));
 }
+
+fn batch_matches_scalar<const N: usize>(chain: &Chain, seeds: &[Vec<f64>]) {
+    let starts: Vec<Cov<N>> = seeds.iter().map(|s| start::<N>(s)).collect();
+    for form in [Form::Covariance, Form::SquareRoot] {
+        let mut batch = starts.clone();
+        let failed = chain.eval_batch(form, &mut batch);
+        let mut f = failed.iter();
+        let mut next = f.next();
+        for (i, c0) in starts.iter().enumerate() {
+            match (checked(chain, form, *c0), next) {
+                (Ok(want), _) => assert_eq!(batch[i], want, "N={N} {form:?} state {i}"),
+                (Err(want), Some((j, got))) if *j == i => {
+                    assert_eq!(got.to_string(), want.to_string());
+                    assert_eq!(batch[i], *c0, "a failed state is left as it was");
+                    next = f.next();
+                }
+                (Err(want), other) => panic!("state {i}: {want} not reported ({other:?})"),
+            }
+        }
+        assert!(next.is_none(), "a state reported that did not fail");
+    }
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(48))]
+
+    #[test]
+    fn batches_give_the_scalar_bits(
+        seeds in prop::collection::vec(prop::collection::vec(-1.0f64..1.0, 25), 1..40),
+        ops in prop::collection::vec((0u8..80, -3.0f64..3.0, 0.0f64..5.0), 1..12),
+        simple in any::<bool>(),
+    ) {
+        // Simple kernels only (the lane path) or any kernel (the per-state path).
+        let mut chain = Chain::new();
+        for &(k, p, q) in &ops {
+            let k = if simple { [0u8, 1, 2, 3, 4][k as usize % 5] + 8 * (k / 8) } else { k };
+            chain.push(K(k, p, q));
+        }
+        batch_matches_scalar::<2>(&chain, &seeds);
+        batch_matches_scalar::<3>(&chain, &seeds);
+        batch_matches_scalar::<4>(&chain, &seeds);
+        batch_matches_scalar::<5>(&chain, &seeds);
+    }
+}
+
+#[test]
+fn batch_reports_failing_states_by_index() {
+    // States 3 and 20 overflow (a huge start); the rest pass; 1,100 states span chunks
+    // and a ragged lane tail.
+    let chain = Chain::new()
+        .with(K(1, 0.0, 1e100))
+        .with(bounce(2.0, 0.6, 0.9, 0.4));
+    let seed: Vec<f64> = (0..25).map(|i| (i as f64 * 0.37).sin()).collect();
+    let mut states = vec![start::<4>(&seed); 1100];
+    for i in [3, 20] {
+        states[i] = Cov::<4>::gaussian([1e-150, 1e-150, 1.0, 1.0]).unwrap();
+    }
+    let before = states.clone();
+    let failed = chain.eval_batch(Form::Covariance, &mut states);
+    let idx: Vec<usize> = failed.iter().map(|(i, _)| *i).collect();
+    assert_eq!(idx, vec![3, 20]);
+    assert!(
+        failed[0].1.to_string().starts_with("step 0 (K)"),
+        "{}",
+        failed[0].1
+    );
+    assert_eq!(states[3], before[3]);
+    let want = chain.eval_in(Form::Covariance, before[1099]).unwrap();
+    assert_eq!(states[1099], want);
+}

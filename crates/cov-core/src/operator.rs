@@ -210,6 +210,7 @@ impl Chain {
             for op in &self.steps {
                 tape.push_shared(op);
             }
+            tape.prepare::<K>();
             tape
         }))
     }
@@ -230,7 +231,7 @@ impl Chain {
 
     /// Every step with its checks: parameters, axes, the kernels' overflow checks and a
     /// finiteness check after each step; Σ is restored to its start on error.
-    fn apply_checked(&self, cov: &mut dyn Spectrum) -> Result<(), CovError> {
+    pub(crate) fn apply_checked(&self, cov: &mut dyn Spectrum) -> Result<(), CovError> {
         let start = cov.snapshot();
         for (index, op) in self.steps.iter().enumerate() {
             if let Err(e) = apply_step(index, op.as_ref(), cov) {

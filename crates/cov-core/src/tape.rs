@@ -39,8 +39,9 @@
 //! # Ok::<(), CovError>(())
 //! ```
 
+use std::any::Any;
 use std::cell::Cell;
-use std::sync::Arc;
+use std::sync::{Arc, OnceLock};
 
 use crate::form::Kernels;
 use crate::linalg::{MAX, Small};
@@ -124,11 +125,124 @@ impl Block {
 }
 
 /// A compiled sequence of kernel calls in one layout and form (see the module docs).
-#[derive(Clone, Debug)]
+#[derive(Debug)]
 pub struct Tape {
     dim: usize,
     form: Form,
     kernels: Vec<Kernel>,
+    /// The kernels lowered for the concrete form (`Vec<Instr<K>>`), built by
+    /// [`Tape::prepare`] for tapes that run many times (a [`crate::Chain`]'s).
+    program: OnceLock<Box<dyn Any + Send + Sync>>,
+}
+
+impl Clone for Tape {
+    fn clone(&self) -> Self {
+        Tape {
+            dim: self.dim,
+            form: self.form,
+            kernels: self.kernels.clone(),
+            program: OnceLock::new(),
+        }
+    }
+}
+
+/// A kernel with constant indices, as a plain function of its two parameters.
+type Fn2<K> = fn(&mut K, f64, f64);
+
+/// One lowered kernel: a constant-index function, the same after a finiteness check
+/// (a lobe, which may zero a row that held ∞), or the general kernel `q` of the tape.
+enum Instr<K> {
+    Plain(Fn2<K>, f64, f64),
+    Checked(Fn2<K>, f64, f64),
+    General(usize),
+}
+
+/// Every (i, j) pair of distinct indices below 5, for the constant-index functions.
+macro_rules! pair_fn {
+    ($i:expr, $j:expr, $k:ident, |$kk:ident, $a:ident, $b:ident, $ci:ident, $cj:ident| $body:expr) => {{
+        macro_rules! one {
+            ($x:literal, $y:literal) => {{
+                let f: Fn2<$k> = |$kk: &mut $k, $a: f64, $b: f64| {
+                    let ($ci, $cj) = ($x, $y);
+                    let _ = ($a, $b, $ci, $cj);
+                    $body
+                };
+                Some(f)
+            }};
+        }
+        match ($i, $j) {
+            (0, 1) => one!(0, 1),
+            (0, 2) => one!(0, 2),
+            (0, 3) => one!(0, 3),
+            (0, 4) => one!(0, 4),
+            (1, 0) => one!(1, 0),
+            (1, 2) => one!(1, 2),
+            (1, 3) => one!(1, 3),
+            (1, 4) => one!(1, 4),
+            (2, 0) => one!(2, 0),
+            (2, 1) => one!(2, 1),
+            (2, 3) => one!(2, 3),
+            (2, 4) => one!(2, 4),
+            (3, 0) => one!(3, 0),
+            (3, 1) => one!(3, 1),
+            (3, 2) => one!(3, 2),
+            (3, 4) => one!(3, 4),
+            (4, 0) => one!(4, 0),
+            (4, 1) => one!(4, 1),
+            (4, 2) => one!(4, 2),
+            (4, 3) => one!(4, 3),
+            _ => None,
+        }
+    }};
+}
+
+/// Every index below 5, for the constant-index functions.
+macro_rules! index_fn {
+    ($i:expr, $k:ident, |$kk:ident, $a:ident, $b:ident, $ci:ident| $body:expr) => {{
+        macro_rules! one {
+            ($x:literal) => {{
+                let f: Fn2<$k> = |$kk: &mut $k, $a: f64, $b: f64| {
+                    let $ci = $x;
+                    let _ = ($a, $b);
+                    $body
+                };
+                Some(f)
+            }};
+        }
+        match $i {
+            0 => one!(0),
+            1 => one!(1),
+            2 => one!(2),
+            3 => one!(3),
+            4 => one!(4),
+            _ => None,
+        }
+    }};
+}
+
+/// Lowers kernel `q` for the concrete form `K`: indices become constants, so each call
+/// is the closed-form update of the few entries it touches.
+fn lower<K: Kernels>(kernel: &Kernel, q: usize) -> Instr<K> {
+    let n = K::DIM;
+    let fits = |i: u8| (i as usize) < n;
+    let plain = |f: Option<Fn2<K>>, a, b| f.map_or(Instr::General(q), |f| Instr::Plain(f, a, b));
+    match *kernel {
+        Kernel::Shear { i, j, s } if fits(i) && fits(j) => {
+            plain(pair_fn!(i, j, K, |k, a, b, ci, cj| k.k_shear(ci, cj, a)), s, 0.0)
+        }
+        Kernel::Rotate { i, j, c, s } if fits(i) && fits(j) => plain(
+            pair_fn!(i, j, K, |k, a, b, ci, cj| k.k_rotate(ci, cj, a, b)),
+            c,
+            s,
+        ),
+        Kernel::Scale { i, c } if fits(i) => plain(index_fn!(i, K, |k, a, b, ci| k.k_scale(ci, a)), c, 0.0),
+        Kernel::AddVariance { i, w } if fits(i) => {
+            plain(index_fn!(i, K, |k, a, b, ci| k.k_add_variance(ci, a)), w, 0.0)
+        }
+        Kernel::Lobe1 { p, s } if fits(p) => index_fn!(p, K, |k, a, b, ci| k.k_lobe_1(ci, a))
+            .map_or(Instr::General(q), |f| Instr::Checked(f, s, 0.0)),
+        _ => Instr::General(q),
+    }
 }
 
 impl Tape {
@@ -144,11 +258,7 @@ impl Tape {
                 got: dim.to_string(),
             });
         }
-        Ok(Tape {
-            dim,
-            form,
-            kernels: Vec::new(),
-        })
+        Ok(Tape::empty(dim, form))
     }
 
     /// An empty tape; `dim` is a valid layout size (from a `Kernels` type).
@@ -157,6 +267,7 @@ impl Tape {
             dim,
             form,
             kernels: Vec::new(),
+            program: OnceLock::new(),
         }
     }
 
@@ -178,6 +289,7 @@ impl Tape {
     /// Empties the tape, keeping its storage (one tape serves ray after ray).
     pub fn clear(&mut self) {
         self.kernels.clear();
+        self.program = OnceLock::new();
     }
 
     /// Appends what `op` does.
@@ -187,6 +299,9 @@ impl Tape {
     /// [`CovError::NoTransport`] if `op` reads Σ, so that its kernel calls cannot be
     /// recorded (use [`Tape::push_shared`]). The tape is unchanged on error.
     pub fn record(&mut self, op: &dyn Operator) -> Result<(), CovError> {
+        if self.program.get().is_some() {
+            self.program = OnceLock::new();
+        }
         let mark = self.kernels.len();
         let mut rec = Recorder {
             tape: self,
@@ -211,6 +326,7 @@ impl Tape {
     /// opaque step then reports the failure when the tape runs).
     pub fn push_shared(&mut self, op: &Arc<dyn Operator>) {
         if self.record(op.as_ref()).is_err() {
+            self.program = OnceLock::new();
             self.kernels.push(Kernel::Opaque(op.clone()));
         }
     }
@@ -232,6 +348,20 @@ impl Tape {
         self.run(&mut f).then_some(f)
     }
 
+    /// Lowers the tape for the concrete form `K` once (constant-index kernels), for a
+    /// tape that will run many times.
+    pub(crate) fn prepare<K: Kernels>(&self) {
+        self.program.get_or_init(|| {
+            let prog: Vec<Instr<K>> = self
+                .kernels
+                .iter()
+                .enumerate()
+                .map(|(q, kernel)| lower::<K>(kernel, q))
+                .collect();
+            Box::new(prog)
+        });
+    }
+
     /// Runs every kernel on `k` in place; false if the layout or form does not match,
     /// an opaque step failed or the result is not finite (`k` is then garbage).
     #[inline]
@@ -239,40 +369,70 @@ impl Tape {
         if K::DIM != self.dim || K::FORM != self.form {
             return false;
         }
-        for kernel in &self.kernels {
-            match kernel {
-                Kernel::Shear { i, j, s } => k.k_shear(*i as usize, *j as usize, *s),
-                Kernel::Scale { i, c } => k.k_scale(*i as usize, *c),
-                Kernel::Rotate { i, j, c, s } => k.k_rotate(*i as usize, *j as usize, *c, *s),
-                Kernel::AddVariance { i, w } => k.k_add_variance(*i as usize, *w),
-                Kernel::Lobe1 { p, s } => {
-                    // A lobe may zero a row that held ∞: check before it.
-                    if !k.all_finite() {
-                        return false;
+        let prog = self.program.get().and_then(|p| p.downcast_ref::<Vec<Instr<K>>>());
+        if let Some(prog) = prog {
+            for ins in prog {
+                match *ins {
+                    Instr::Plain(f, a, b) => f(k, a, b),
+                    Instr::Checked(f, a, b) => {
+                        if !k.all_finite() {
+                            return false;
+                        }
+                        f(k, a, b)
                     }
-                    k.k_lobe_1(*p as usize, *s)
+                    Instr::General(q) => {
+                        if !self.run_kernel(k, &self.kernels[q]) {
+                            return false;
+                        }
+                    }
                 }
-                Kernel::AddWindow(b) => {
-                    if !k.all_finite() {
-                        return false;
-                    }
-                    k.k_add_window(&b.p[..b.k], &b.m)
-                }
-                Kernel::Lobe(b) => {
-                    if !k.all_finite() {
-                        return false;
-                    }
-                    k.k_lobe(&b.p[..b.k], &b.m)
-                }
-                Kernel::Congruence(a) => k.k_congruence(a),
-                Kernel::Opaque(op) => {
-                    if !k.all_finite() || op.apply(k).is_err() {
-                        return false;
-                    }
+            }
+        } else {
+            for kernel in &self.kernels {
+                if !self.run_kernel(k, kernel) {
+                    return false;
                 }
             }
         }
         k.all_finite()
+    }
+
+    /// One kernel with run-time indices; false if a check before it or an opaque step
+    /// failed.
+    #[inline]
+    fn run_kernel<K: Kernels>(&self, k: &mut K, kernel: &Kernel) -> bool {
+        match kernel {
+            Kernel::Shear { i, j, s } => k.k_shear(*i as usize, *j as usize, *s),
+            Kernel::Scale { i, c } => k.k_scale(*i as usize, *c),
+            Kernel::Rotate { i, j, c, s } => k.k_rotate(*i as usize, *j as usize, *c, *s),
+            Kernel::AddVariance { i, w } => k.k_add_variance(*i as usize, *w),
+            // A lobe may zero a row that held ∞: check before it.
+            Kernel::Lobe1 { p, s } => {
+                if !k.all_finite() {
+                    return false;
+                }
+                k.k_lobe_1(*p as usize, *s)
+            }
+            Kernel::AddWindow(b) => {
+                if !k.all_finite() {
+                    return false;
+                }
+                k.k_add_window(&b.p[..b.k], &b.m)
+            }
+            Kernel::Lobe(b) => {
+                if !k.all_finite() {
+                    return false;
+                }
+                k.k_lobe(&b.p[..b.k], &b.m)
+            }
+            Kernel::Congruence(a) => k.k_congruence(a),
+            Kernel::Opaque(op) => {
+                if !k.all_finite() || op.apply(k).is_err() {
+                    return false;
+                }
+            }
+        }
+        true
     }
 }
 

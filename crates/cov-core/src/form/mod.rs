@@ -22,7 +22,7 @@ pub(crate) fn overflow_at(check: Result<(), crate::CovError>) -> Option<(usize, 
 /// checks finiteness where a later kernel could hide them and at the end. Each computes
 /// exactly what the matching checked `raw_*` kernel of [`crate::Spectrum`] computes, so a
 /// compiled chain and a checked one give the same bits.
-pub(crate) trait Kernels: crate::Spectrum + Copy {
+pub(crate) trait Kernels: crate::Spectrum + Copy + Send + Sync + 'static {
     /// The form.
     const FORM: crate::Form;
     /// The layout size.

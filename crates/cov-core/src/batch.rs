@@ -1,0 +1,322 @@
+//! Batch evaluation: one chain over many states ([`Chain::eval_batch`]), what a renderer
+//! calls for a tile of paths. The chain is compiled once ([`Tape`]); states run in
+//! parallel over cores (rayon, in chunks of [`CHUNK`]); in covariance form, groups of
+//! [`LANES`] states are stored structure-of-arrays (entry by entry, state by state) so
+//! that each kernel runs as plain loops over the lanes, which the compiler vectorises.
+//! Every lane computes exactly what the scalar kernels compute (same operations in the
+//! same order), so a batch gives the same bits as [`Chain::eval_in`].
+
+use rayon::prelude::*;
+
+use crate::tape::Kernel;
+use crate::{Chain, Cov, CovError, CovFactor, Form, Tape};
+
+/// States stored side by side in the structure-of-arrays groups.
+pub const LANES: usize = 8;
+
+/// States per parallel task.
+pub const CHUNK: usize = 512;
+
+type Lanes = [[f64; LANES]; 15];
+
+#[inline(always)]
+const fn ix<const N: usize>(i: usize, j: usize) -> usize {
+    let (i, j) = if i <= j { (i, j) } else { (j, i) };
+    i * N - i * (i + 1) / 2 + j
+}
+
+impl Chain {
+    /// Evaluates the chain on every state in place, in `form`, in parallel: the
+    /// batched form of [`Chain::eval_in`], with the same result bits per state.
+    ///
+    /// Returns the states that failed, with their error (as [`Chain::eval_in`] reports
+    /// it: step, operator, value); those states are left as they were.
+    ///
+    /// ```
+    /// use cov_core::{Axis, Chain, Cov, CovError, Form, Operator, Spectrum};
+    /// # #[derive(Debug)] struct Travel(f64);
+    /// # impl Operator for Travel {
+    /// #     fn apply(&self, c: &mut dyn Spectrum) -> Result<(), CovError> { c.shear(Axis::X, Axis::U, -self.0) }
+    /// # }
+    /// let chain = Chain::new().with(Travel(1.0)).with(Travel(2.0));
+    /// let mut states: Vec<Cov<2>> = (1..=100)
+    ///     .map(|i| Cov::gaussian([0.01 * i as f64, 1.0]))
+    ///     .collect::<Result<_, _>>()?;
+    /// let one = chain.eval_in(Form::Covariance, states[7])?;
+    /// let failed = chain.eval_batch(Form::Covariance, &mut states);
+    /// assert!(failed.is_empty());
+    /// assert_eq!(states[7], one);
+    /// # Ok::<(), CovError>(())
+    /// ```
+    pub fn eval_batch<const N: usize>(&self, form: Form, states: &mut [Cov<N>]) -> Vec<(usize, CovError)> {
+        let Ok(tape) = self.compile(N, form) else {
+            return Vec::new(); // unreachable: Cov<N> has N in 2..=5
+        };
+        let lanes_ok = form == Form::Covariance
+            && tape.kernels().iter().all(|k| {
+                matches!(
+                    k,
+                    Kernel::Shear { .. }
+                        | Kernel::Scale { .. }
+                        | Kernel::Rotate { .. }
+                        | Kernel::AddVariance { .. }
+                        | Kernel::Lobe1 { .. }
+                )
+            });
+        match form {
+            Form::Covariance => tape.prepare::<Cov<N>>(),
+            Form::SquareRoot => tape.prepare::<CovFactor<N>>(),
+        }
+        let mut failed: Vec<(usize, CovError)> = states
+            .par_chunks_mut(CHUNK)
+            .enumerate()
+            .flat_map_iter(|(c, chunk)| {
+                let mut bad = Vec::new();
+                if lanes_ok {
+                    self.run_lanes(&tape, chunk, c * CHUNK, &mut bad);
+                } else {
+                    for (i, s) in chunk.iter_mut().enumerate() {
+                        self.run_one(&tape, form, s, c * CHUNK + i, &mut bad);
+                    }
+                }
+                bad
+            })
+            .collect();
+        failed.sort_by_key(|(i, _)| *i);
+        failed
+    }
+
+    /// One state through the tape; on failure the checked path reports it.
+    fn run_one<const N: usize>(
+        &self,
+        tape: &Tape,
+        form: Form,
+        s: &mut Cov<N>,
+        index: usize,
+        bad: &mut Vec<(usize, CovError)>,
+    ) {
+        let ok = match form {
+            Form::Covariance => {
+                let mut c = *s;
+                tape.run(&mut c).then(|| *s = c).is_some()
+            }
+            Form::SquareRoot => {
+                let mut f = CovFactor::from_cov(s);
+                tape.run(&mut f) && f.to_cov().map(|c| *s = c).is_ok()
+            }
+        };
+        if !ok {
+            self.report_failure(form, s, index, bad);
+        }
+    }
+
+    fn report_failure<const N: usize>(
+        &self,
+        form: Form,
+        s: &Cov<N>,
+        index: usize,
+        bad: &mut Vec<(usize, CovError)>,
+    ) {
+        let checked = match form {
+            Form::Covariance => self.apply_checked(&mut s.clone()),
+            Form::SquareRoot => {
+                let mut f = CovFactor::from_cov(s);
+                self.apply_checked(&mut f).and_then(|()| f.to_cov().map(|_| ()))
+            }
+        };
+        let e = match checked {
+            Err(e) => e,
+            // The checked path succeeded where the tape did not: impossible when the
+            // kernels agree; report it rather than hide it.
+            Ok(()) => CovError::NoTransport {
+                operator: "Chain::eval_batch".into(),
+                reason: "the compiled and the checked evaluation disagree".into(),
+            },
+        };
+        bad.push((index, e));
+    }
+
+    /// Groups of [`LANES`] states in structure-of-arrays form through the tape's simple
+    /// kernels; a ragged tail and failing lanes go through [`Chain::run_one`].
+    fn run_lanes<const N: usize>(
+        &self,
+        tape: &Tape,
+        chunk: &mut [Cov<N>],
+        base: usize,
+        bad: &mut Vec<(usize, CovError)>,
+    ) {
+        let done = chunk.len() - chunk.len() % LANES;
+        for (g, group) in chunk[..done].chunks_exact_mut(LANES).enumerate() {
+            let mut a: Lanes = [[0.0; LANES]; 15];
+            for (l, s) in group.iter().enumerate() {
+                for (e, v) in s.packed().iter().enumerate() {
+                    a[e][l] = *v;
+                }
+            }
+            let mut poisoned = [false; LANES];
+            for k in tape.kernels() {
+                match *k {
+                    Kernel::Shear { i, j, s } => shear::<N>(&mut a, i as usize, j as usize, s),
+                    Kernel::Scale { i, c } => scale::<N>(&mut a, i as usize, c),
+                    Kernel::Rotate { i, j, c, s } => rotate::<N>(&mut a, i as usize, j as usize, c, s),
+                    Kernel::AddVariance { i, w } => {
+                        let d = &mut a[ix::<N>(i as usize, i as usize)];
+                        for v in d.iter_mut() {
+                            *v += w;
+                        }
+                    }
+                    Kernel::Lobe1 { p, s } => {
+                        // As the scalar tape: a lobe may hide an ∞, so check before it.
+                        mark_non_finite::<N>(&a, &mut poisoned);
+                        lobe_1::<N>(&mut a, p as usize, s);
+                    }
+                    _ => unreachable!("run_lanes is only called on simple kernels"),
+                }
+            }
+            mark_non_finite::<N>(&a, &mut poisoned);
+            for (l, s) in group.iter_mut().enumerate() {
+                if poisoned[l] {
+                    self.report_failure(Form::Covariance, s, base + g * LANES + l, bad);
+                    continue;
+                }
+                let mut c = Cov::<N>::zeros();
+                for i in 0..N {
+                    for j in i..N {
+                        c.set(i, j, a[ix::<N>(i, j)][l]);
+                    }
+                }
+                *s = c;
+            }
+        }
+        for (i, s) in chunk[done..].iter_mut().enumerate() {
+            self.run_one(tape, Form::Covariance, s, base + done + i, bad);
+        }
+    }
+}
+
+#[inline(always)]
+fn mark_non_finite<const N: usize>(a: &Lanes, poisoned: &mut [bool; LANES]) {
+    for e in a.iter().take(N * (N + 1) / 2) {
+        for l in 0..LANES {
+            poisoned[l] |= !e[l].is_finite();
+        }
+    }
+}
+
+/// `Cov::shear_col` then commit, lane by lane.
+#[inline(always)]
+fn shear<const N: usize>(a: &mut Lanes, i: usize, j: usize, s: f64) {
+    let (ii, ij, jj) = (ix::<N>(i, i), ix::<N>(i, j), ix::<N>(j, j));
+    let mut diag = [0.0; LANES];
+    for l in 0..LANES {
+        diag[l] = (a[jj][l] + s * (2.0 * a[ij][l] + s * a[ii][l])).abs();
+    }
+    for k in 0..N {
+        if k != j {
+            let (kj, ki) = (ix::<N>(k, j), ix::<N>(k, i));
+            for l in 0..LANES {
+                a[kj][l] += s * a[ki][l];
+            }
+        }
+    }
+    a[jj] = diag;
+}
+
+/// `Cov::scale_col` then commit, lane by lane.
+#[inline(always)]
+fn scale<const N: usize>(a: &mut Lanes, i: usize, c: f64) {
+    for k in 0..N {
+        let f = if k == i { c * c } else { c };
+        let e = &mut a[ix::<N>(k, i)];
+        for v in e.iter_mut() {
+            *v *= f;
+        }
+    }
+}
+
+/// `Cov::rotate_idx`, lane by lane.
+#[inline(always)]
+fn rotate<const N: usize>(a: &mut Lanes, i: usize, j: usize, c: f64, s: f64) {
+    let (ii, ij, jj) = (ix::<N>(i, i), ix::<N>(i, j), ix::<N>(j, j));
+    let (sii, sij, sjj) = (a[ii], a[ij], a[jj]);
+    for k in 0..N {
+        if k != i && k != j {
+            let (ki, kj) = (ix::<N>(k, i), ix::<N>(k, j));
+            for l in 0..LANES {
+                let (x, y) = (a[ki][l], a[kj][l]);
+                a[ki][l] = c * x + s * y;
+                a[kj][l] = c * y - s * x;
+            }
+        }
+    }
+    let cs = c * s;
+    for l in 0..LANES {
+        a[ii][l] = (c * c * sii[l] + 2.0 * cs * sij[l] + s * s * sjj[l]).abs();
+        a[jj][l] = (s * s * sii[l] - 2.0 * cs * sij[l] + c * c * sjj[l]).abs();
+        a[ij][l] = cs * (sjj[l] - sii[l]) + (c * c - s * s) * sij[l];
+    }
+}
+
+/// `Cov::lobe_product_1` with its snap, lane by lane.
+#[inline(always)]
+fn lobe_1<const N: usize>(a: &mut Lanes, p: usize, s: f64) {
+    let mut before = [[0.0; LANES]; 5];
+    for (i, b) in before.iter_mut().enumerate().take(N) {
+        *b = a[ix::<N>(i, i)];
+    }
+    let pp = ix::<N>(p, p);
+    let spp = a[pp];
+    let mut inv = [0.0; LANES];
+    let mut t = [0.0; LANES];
+    for l in 0..LANES {
+        let m = s + spp[l];
+        (inv[l], t[l]) = if m > 0.0 { (1.0 / m, s / m) } else { (0.0, 0.0) };
+    }
+    let mut col = [[0.0; LANES]; 5];
+    for (o, c) in col.iter_mut().enumerate().take(N) {
+        *c = a[ix::<N>(o, p)];
+    }
+    for x in 0..N {
+        if x == p {
+            continue;
+        }
+        let mut g = [0.0; LANES];
+        for l in 0..LANES {
+            g[l] = col[x][l] * inv[l];
+        }
+        for y in x..N {
+            if y != p {
+                let e = &mut a[ix::<N>(x, y)];
+                for l in 0..LANES {
+                    e[l] -= g[l] * col[y][l];
+                }
+            }
+        }
+        let e = &mut a[ix::<N>(x, p)];
+        for l in 0..LANES {
+            e[l] = col[x][l] * t[l];
+        }
+    }
+    for l in 0..LANES {
+        a[pp][l] = spp[l] * t[l];
+    }
+    // `Cov::snap_cancelled`: a diagonal that is negative, had no content, or (off the
+    // lobe's axis) cancelled to SCHUR_SNAP of its value is noise; its row and column
+    // become 0.
+    for x in 0..N {
+        let d = a[ix::<N>(x, x)];
+        let mut noise = [false; LANES];
+        for l in 0..LANES {
+            noise[l] =
+                d[l] < 0.0 || before[x][l] <= 0.0 || (x != p && d[l] <= crate::SCHUR_SNAP * before[x][l]);
+        }
+        for y in 0..N {
+            let e = &mut a[ix::<N>(x, y)];
+            for l in 0..LANES {
+                if noise[l] {
+                    e[l] = 0.0;
+                }
+            }
+        }
+    }
+}
