@@ -8,7 +8,7 @@
 
 use rayon::prelude::*;
 
-use crate::tape::Kernel;
+use crate::tape::{Fn2, Kernel, index_fn, pair_fn};
 use crate::{Chain, Cov, CovError, CovFactor, Form, Tape};
 
 /// States stored side by side in the structure-of-arrays groups.
@@ -145,35 +145,29 @@ impl Chain {
         base: usize,
         bad: &mut Vec<(usize, CovError)>,
     ) {
+        let Some(prog) = lower_lanes::<N>(tape) else {
+            for (i, s) in chunk.iter_mut().enumerate() {
+                self.run_one(tape, Form::Covariance, s, base + i, bad);
+            }
+            return;
+        };
         let done = chunk.len() - chunk.len() % LANES;
         for (g, group) in chunk[..done].chunks_exact_mut(LANES).enumerate() {
-            let mut a: Lanes = [[0.0; LANES]; 15];
+            let mut a = LaneCov::<N>([[0.0; LANES]; 15]);
             for (l, s) in group.iter().enumerate() {
                 for (e, v) in s.packed().iter().enumerate() {
-                    a[e][l] = *v;
+                    a.0[e][l] = *v;
                 }
             }
             let mut poisoned = [false; LANES];
-            for k in tape.kernels() {
-                match *k {
-                    Kernel::Shear { i, j, s } => shear::<N>(&mut a, i as usize, j as usize, s),
-                    Kernel::Scale { i, c } => scale::<N>(&mut a, i as usize, c),
-                    Kernel::Rotate { i, j, c, s } => rotate::<N>(&mut a, i as usize, j as usize, c, s),
-                    Kernel::AddVariance { i, w } => {
-                        let d = &mut a[ix::<N>(i as usize, i as usize)];
-                        for v in d.iter_mut() {
-                            *v += w;
-                        }
-                    }
-                    Kernel::Lobe1 { p, s } => {
-                        // As the scalar tape: a lobe may hide an ∞, so check before it.
-                        mark_non_finite::<N>(&a, &mut poisoned);
-                        lobe_1::<N>(&mut a, p as usize, s);
-                    }
-                    _ => unreachable!("run_lanes is only called on simple kernels"),
+            for (f, x, y, check) in &prog {
+                if *check {
+                    // As the scalar tape: a lobe may hide an ∞, so check before it.
+                    mark_non_finite::<N>(&a.0, &mut poisoned);
                 }
+                f(&mut a, *x, *y);
             }
-            mark_non_finite::<N>(&a, &mut poisoned);
+            mark_non_finite::<N>(&a.0, &mut poisoned);
             for (l, s) in group.iter_mut().enumerate() {
                 if poisoned[l] {
                     self.report_failure(Form::Covariance, s, base + g * LANES + l, bad);
@@ -182,7 +176,7 @@ impl Chain {
                 let mut c = Cov::<N>::zeros();
                 for i in 0..N {
                     for j in i..N {
-                        c.set(i, j, a[ix::<N>(i, j)][l]);
+                        c.set(i, j, a.0[ix::<N>(i, j)][l]);
                     }
                 }
                 *s = c;
@@ -192,6 +186,51 @@ impl Chain {
             self.run_one(tape, Form::Covariance, s, base + done + i, bad);
         }
     }
+}
+
+/// Lanes of one layout, for the constant-index lane kernels.
+struct LaneCov<const N: usize>(Lanes);
+
+/// A lane kernel, its two parameters, and whether a finiteness check goes first.
+type LaneInstr<const N: usize> = (Fn2<LaneCov<N>>, f64, f64, bool);
+
+/// The tape's simple kernels as constant-index lane kernels (`None` if one is not
+/// simple or out of range).
+fn lower_lanes<const N: usize>(tape: &Tape) -> Option<Vec<LaneInstr<N>>> {
+    let fits = |i: u8| (i as usize) < N;
+    tape.kernels()
+        .iter()
+        .map(|k| match *k {
+            Kernel::Shear { i, j, s } if fits(i) && fits(j) => {
+                pair_fn!(i, j, LaneCov<N>, |k, a, b, ci, cj| shear::<N>(
+                    &mut k.0, ci, cj, a
+                ))
+                .map(|f| (f, s, 0.0, false))
+            }
+            Kernel::Rotate { i, j, c, s } if fits(i) && fits(j) => {
+                pair_fn!(i, j, LaneCov<N>, |k, a, b, ci, cj| rotate::<N>(
+                    &mut k.0, ci, cj, a, b
+                ))
+                .map(|f| (f, c, s, false))
+            }
+            Kernel::Scale { i, c } if fits(i) => {
+                index_fn!(i, LaneCov<N>, |k, a, b, ci| scale::<N>(&mut k.0, ci, a))
+                    .map(|f| (f, c, 0.0, false))
+            }
+            Kernel::AddVariance { i, w } if fits(i) => index_fn!(i, LaneCov<N>, |k, a, b, ci| {
+                let d = &mut k.0[ix::<N>(ci, ci)];
+                for v in d.iter_mut() {
+                    *v += a;
+                }
+            })
+            .map(|f| (f, w, 0.0, false)),
+            Kernel::Lobe1 { p, s } if fits(p) => {
+                index_fn!(p, LaneCov<N>, |k, a, b, ci| lobe_1::<N>(&mut k.0, ci, a))
+                    .map(|f| (f, s, 0.0, true))
+            }
+            _ => None,
+        })
+        .collect()
 }
 
 #[inline(always)]

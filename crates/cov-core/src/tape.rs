@@ -147,7 +147,7 @@ impl Clone for Tape {
 }
 
 /// A kernel with constant indices, as a plain function of its two parameters.
-type Fn2<K> = fn(&mut K, f64, f64);
+pub(crate) type Fn2<K> = fn(&mut K, f64, f64);
 
 /// One lowered kernel: a constant-index function, the same after a finiteness check
 /// (a lobe, which may zero a row that held ∞), or the general kernel `q` of the tape.
@@ -159,7 +159,7 @@ enum Instr<K> {
 
 /// Every (i, j) pair of distinct indices below 5, for the constant-index functions.
 macro_rules! pair_fn {
-    ($i:expr, $j:expr, $k:ident, |$kk:ident, $a:ident, $b:ident, $ci:ident, $cj:ident| $body:expr) => {{
+    ($i:expr, $j:expr, $k:ty, |$kk:ident, $a:ident, $b:ident, $ci:ident, $cj:ident| $body:expr) => {{
         macro_rules! one {
             ($x:literal, $y:literal) => {{
                 let f: Fn2<$k> = |$kk: &mut $k, $a: f64, $b: f64| {
@@ -198,7 +198,7 @@ macro_rules! pair_fn {
 
 /// Every index below 5, for the constant-index functions.
 macro_rules! index_fn {
-    ($i:expr, $k:ident, |$kk:ident, $a:ident, $b:ident, $ci:ident| $body:expr) => {{
+    ($i:expr, $k:ty, |$kk:ident, $a:ident, $b:ident, $ci:ident| $body:expr) => {{
         macro_rules! one {
             ($x:literal) => {{
                 let f: Fn2<$k> = |$kk: &mut $k, $a: f64, $b: f64| {
@@ -219,6 +219,8 @@ macro_rules! index_fn {
         }
     }};
 }
+
+pub(crate) use {index_fn, pair_fn};
 
 /// Lowers kernel `q` for the concrete form `K`: indices become constants, so each call
 /// is the closed-form update of the few entries it touches.
