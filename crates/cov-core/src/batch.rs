@@ -19,10 +19,10 @@ pub const CHUNK: usize = 512;
 
 type Lanes = [[f64; LANES]; 15];
 
+/// Packed index of `(i, j)`, as `Cov<N>` stores it.
 #[inline(always)]
 const fn ix<const N: usize>(i: usize, j: usize) -> usize {
-    let (i, j) = if i <= j { (i, j) } else { (j, i) };
-    i * N - i * (i + 1) / 2 + j
+    Cov::<N>::idx(i, j)
 }
 
 impl Chain {
@@ -49,34 +49,29 @@ impl Chain {
     /// # Ok::<(), CovError>(())
     /// ```
     pub fn eval_batch<const N: usize>(&self, form: Form, states: &mut [Cov<N>]) -> Vec<(usize, CovError)> {
-        let Ok(tape) = self.compile(N, form) else {
-            return Vec::new(); // unreachable: Cov<N> has N in 2..=5
+        // The chain's cached tape, lowered for the form; in covariance form also the
+        // lane program (`None` if a kernel has no lane form: each state then runs alone).
+        let (tape, lanes) = match form {
+            Form::Covariance => {
+                let tape = self.tape::<Cov<N>>(true);
+                (tape, tape.and_then(lower_lanes::<N>))
+            }
+            Form::SquareRoot => (self.tape::<CovFactor<N>>(true), None),
         };
-        let lanes_ok = form == Form::Covariance
-            && tape.kernels().iter().all(|k| {
-                matches!(
-                    k,
-                    Kernel::Shear { .. }
-                        | Kernel::Scale { .. }
-                        | Kernel::Rotate { .. }
-                        | Kernel::AddVariance { .. }
-                        | Kernel::Lobe1 { .. }
-                )
-            });
-        match form {
-            Form::Covariance => tape.prepare::<Cov<N>>(),
-            Form::SquareRoot => tape.prepare::<CovFactor<N>>(),
-        }
+        let Some(tape) = tape else {
+            return Vec::new(); // unreachable: a forced tape is always built
+        };
         let mut failed: Vec<(usize, CovError)> = states
             .par_chunks_mut(CHUNK)
             .enumerate()
             .flat_map_iter(|(c, chunk)| {
                 let mut bad = Vec::new();
-                if lanes_ok {
-                    self.run_lanes(&tape, chunk, c * CHUNK, &mut bad);
-                } else {
-                    for (i, s) in chunk.iter_mut().enumerate() {
-                        self.run_one(&tape, form, s, c * CHUNK + i, &mut bad);
+                match &lanes {
+                    Some(prog) => self.run_lanes(tape, prog, chunk, c * CHUNK, &mut bad),
+                    None => {
+                        for (i, s) in chunk.iter_mut().enumerate() {
+                            self.run_one(tape, form, s, c * CHUNK + i, &mut bad);
+                        }
                     }
                 }
                 bad
@@ -98,7 +93,11 @@ impl Chain {
         let ok = match form {
             Form::Covariance => {
                 let mut c = *s;
-                tape.run(&mut c).then(|| *s = c).is_some()
+                let ok = tape.run(&mut c);
+                if ok {
+                    *s = c;
+                }
+                ok
             }
             Form::SquareRoot => {
                 let mut f = CovFactor::from_cov(s);
@@ -136,21 +135,16 @@ impl Chain {
         bad.push((index, e));
     }
 
-    /// Groups of [`LANES`] states in structure-of-arrays form through the tape's simple
-    /// kernels; a ragged tail and failing lanes go through [`Chain::run_one`].
+    /// Groups of [`LANES`] states in structure-of-arrays form through `prog` (the tape's
+    /// lane program); a ragged tail and failing lanes go through [`Chain::run_one`].
     fn run_lanes<const N: usize>(
         &self,
         tape: &Tape,
+        prog: &[LaneInstr<N>],
         chunk: &mut [Cov<N>],
         base: usize,
         bad: &mut Vec<(usize, CovError)>,
     ) {
-        let Some(prog) = lower_lanes::<N>(tape) else {
-            for (i, s) in chunk.iter_mut().enumerate() {
-                self.run_one(tape, Form::Covariance, s, base + i, bad);
-            }
-            return;
-        };
         let done = chunk.len() - chunk.len() % LANES;
         for (g, group) in chunk[..done].chunks_exact_mut(LANES).enumerate() {
             let mut a = LaneCov::<N>([[0.0; LANES]; 15]);
@@ -160,7 +154,7 @@ impl Chain {
                 }
             }
             let mut poisoned = [false; LANES];
-            for (f, x, y, check) in &prog {
+            for (f, x, y, check) in prog {
                 if *check {
                     // As the scalar tape: a lobe may hide an ∞, so check before it.
                     mark_non_finite::<N>(&a.0, &mut poisoned);

@@ -116,7 +116,8 @@ pub struct Chain {
     steps: Vec<Arc<dyn Operator>>,
     /// Compiled tapes, one per (layout, form), built on the second evaluation in that
     /// layout and form (a chain evaluated once, as a renderer's per-path chain is, is not
-    /// worth recording). Shared by clones; reset by every change of the steps.
+    /// worth recording) or by the first [`Chain::eval_batch`]. Shared by clones; reset by
+    /// every change of the steps.
     compiled: Arc<Compiled>,
 }
 
@@ -188,28 +189,31 @@ impl Chain {
     /// [`CovError::Shape`] for a layout size outside 2..=5.
     pub fn compile(&self, dim: usize, form: Form) -> Result<Tape, CovError> {
         let mut tape = Tape::new(dim, form)?;
-        for op in &self.steps {
-            tape.push_shared(op);
-        }
+        self.record_into(&mut tape);
         Ok(tape)
     }
 
-    /// The cached tape of layout `K::DIM` and form `K::FORM`, once the chain has been
-    /// evaluated there before (`None` on a first evaluation).
-    fn tape<K: Kernels>(&self) -> Option<&Tape> {
+    fn record_into(&self, tape: &mut Tape) {
+        for op in &self.steps {
+            tape.push_shared(op);
+        }
+    }
+
+    /// The cached tape of layout `K::DIM` and form `K::FORM`, lowered for `K`. Without
+    /// `force`, only once the chain has been evaluated there before (`None` on a first
+    /// evaluation); a batch forces it.
+    pub(crate) fn tape<K: Kernels>(&self, force: bool) -> Option<&Tape> {
         let slot = (K::DIM - 2) * 2 + usize::from(K::FORM == Form::SquareRoot);
         let c = &self.compiled;
         if let Some(t) = c.tapes[slot].get() {
             return Some(t);
         }
-        if c.uses[slot].fetch_add(1, Ordering::Relaxed) == 0 {
+        if !force && c.uses[slot].fetch_add(1, Ordering::Relaxed) == 0 {
             return None;
         }
         Some(c.tapes[slot].get_or_init(|| {
             let mut tape = Tape::empty(K::DIM, K::FORM);
-            for op in &self.steps {
-                tape.push_shared(op);
-            }
+            self.record_into(&mut tape);
             tape.prepare::<K>();
             tape
         }))
@@ -219,7 +223,7 @@ impl Chain {
     /// it ran clean; otherwise (or on a first evaluation) the checked path, which finds
     /// and reports the failing step and leaves Σ as it was.
     fn apply_fast<K: Kernels>(&self, k: &mut K) -> Result<(), CovError> {
-        if let Some(tape) = self.tape::<K>() {
+        if let Some(tape) = self.tape::<K>(false) {
             let mut work = *k;
             if tape.run(&mut work) {
                 *k = work;
@@ -386,9 +390,7 @@ impl Operator for Chain {
             Concrete::Factor4(f) => self.apply_fast(f),
             Concrete::Factor5(f) => self.apply_fast(f),
             Concrete::Tape(tape) => {
-                for op in &self.steps {
-                    tape.push_shared(op);
-                }
+                self.record_into(tape);
                 Ok(())
             }
             Concrete::Other => self.apply_checked(cov),

@@ -291,7 +291,7 @@ impl Tape {
     /// Empties the tape, keeping its storage (one tape serves ray after ray).
     pub fn clear(&mut self) {
         self.kernels.clear();
-        self.program = OnceLock::new();
+        self.program.take();
     }
 
     /// Appends what `op` does.
@@ -301,9 +301,7 @@ impl Tape {
     /// [`CovError::NoTransport`] if `op` reads Σ, so that its kernel calls cannot be
     /// recorded (use [`Tape::push_shared`]). The tape is unchanged on error.
     pub fn record(&mut self, op: &dyn Operator) -> Result<(), CovError> {
-        if self.program.get().is_some() {
-            self.program = OnceLock::new();
-        }
+        self.program.take();
         let mark = self.kernels.len();
         let mut rec = Recorder {
             tape: self,
@@ -328,7 +326,6 @@ impl Tape {
     /// opaque step then reports the failure when the tape runs).
     pub fn push_shared(&mut self, op: &Arc<dyn Operator>) {
         if self.record(op.as_ref()).is_err() {
-            self.program = OnceLock::new();
             self.kernels.push(Kernel::Opaque(op.clone()));
         }
     }

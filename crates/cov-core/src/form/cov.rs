@@ -424,14 +424,7 @@ impl<const N: usize> Cov<N> {
     /// untouched and the first overflowing entry is reported.
     #[inline(always)]
     fn commit_column(&mut self, op: &str, j: usize, col: &[f64; N]) -> Result<(), CovError> {
-        if let Some(k) = col.iter().position(|v| !v.is_finite()) {
-            return Err(CovError::Overflow {
-                operator: op.into(),
-                row: k.min(j),
-                col: k.max(j),
-                value: col[k],
-            });
-        }
+        super::require_finite_line(op, col, |k| (k.min(j), k.max(j)))?;
         for (k, v) in col.iter().enumerate() {
             self.set(k, j, *v);
         }

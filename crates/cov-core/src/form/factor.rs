@@ -215,14 +215,7 @@ impl<const N: usize> CovFactor<N> {
     /// Writes row `i` if it is finite; otherwise the factor is untouched.
     #[inline(always)]
     fn commit_row(&mut self, op: &str, i: usize, row: [f64; N]) -> Result<(), CovError> {
-        if let Some(c) = row.iter().position(|v| !v.is_finite()) {
-            return Err(CovError::Overflow {
-                operator: op.into(),
-                row: i,
-                col: c,
-                value: row[c],
-            });
-        }
+        super::require_finite_line(op, &row, |c| (i, c))?;
         self.l[i] = row;
         Ok(())
     }

@@ -16,6 +16,28 @@ pub(crate) fn overflow_at(check: Result<(), crate::CovError>) -> Option<(usize, 
     })
 }
 
+/// Checks a new row or column before a kernel writes it: the first non-finite entry is
+/// an overflow of `op`, at the (row, column) `at(k)` gives for position `k`.
+#[inline(always)]
+pub(crate) fn require_finite_line(
+    op: &str,
+    line: &[f64],
+    at: impl Fn(usize) -> (usize, usize),
+) -> Result<(), crate::CovError> {
+    match line.iter().position(|v| !v.is_finite()) {
+        None => Ok(()),
+        Some(k) => {
+            let (row, col) = at(k);
+            Err(crate::CovError::Overflow {
+                operator: op.into(),
+                row,
+                col,
+                value: line[k],
+            })
+        }
+    }
+}
+
 /// The unchecked in-place kernels of a concrete form, for compiled chains
 /// ([`crate::Tape`]). Indices are resolved and parameters checked when the tape is
 /// recorded; these kernels do not check their output: ∞ and NaN propagate, and the tape
