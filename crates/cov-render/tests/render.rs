@@ -120,3 +120,36 @@ fn covariance_maps_are_finite_psd_and_see_the_scene() {
         4
     );
 }
+
+/// The covariance pass weights each path by the radiance it carries (ignoring visibility
+/// towards the light). Where nothing blocks the light and no light arrives after a bounce,
+/// a diffuse plane under a sphere light, the weights must estimate the closed-form radiance
+/// `ρ L (R/D)²` within their Monte Carlo error: the maps average Σ with the image's own
+/// radiance, not a biased stand-in.
+#[test]
+fn the_covariance_pass_weights_estimate_the_radiance() {
+    use cov_render::covpass::{CovCamera, trace_path};
+    use rand::{Rng, SeedableRng};
+    let world = common::plane_under_sphere_light(0.5, 1, 1);
+    let exact = 0.5 * (0.5f64 / 2.0).powi(2);
+    let cc = CovCamera::new(&world).unwrap();
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(11);
+    let m = 100_000;
+    let (mut sum, mut sum2) = (0.0, 0.0);
+    for _ in 0..m {
+        let (px, py, ut) = (rng.random::<f64>(), rng.random::<f64>(), rng.random::<f64>());
+        let (rates, w) = trace_path(&world, &cc, px, py, ut, &mut rng)
+            .unwrap()
+            .expect("the plane is seen");
+        assert!(rates.samples_per_pixel.is_finite() && rates.image_cov_px[0][0] >= 0.0);
+        sum += w;
+        sum2 += w * w;
+    }
+    let mean = sum / f64::from(m);
+    let se = ((sum2 / f64::from(m) - mean * mean) / f64::from(m)).sqrt();
+    assert!(se > 0.0 && se < 0.005 * exact, "stderr {se}");
+    assert!(
+        (mean - exact).abs() <= 4.0 * se,
+        "weights {mean} ± {se}, closed form {exact}"
+    );
+}
