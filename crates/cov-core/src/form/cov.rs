@@ -13,8 +13,9 @@ use crate::{AnyCov, AnySpectrum, Cov, CovError, Form, Spectrum};
 /// remains below `64 ε` is not information. The snap sets such an entry to 0 with its row
 /// and column: it errs towards a smaller bandwidth, and is exact when the true value is 0
 /// (a point light through a diffuse bounce). Where the true value is small but well
-/// determined by the parameters, it is lost (the square-root form's [`crate::ROW_SNAP`]
-/// makes the same decision). See [`Spectrum::convolve`] and
+/// determined by the parameters (a 1e-9 m window refocused by a lobe), it is lost here
+/// and kept by the square-root form, whose [`crate::ROW_SNAP`] drops only the part of a
+/// cancelled row orthogonal to the lobe's row. See [`Spectrum::convolve`] and
 /// [`Spectrum::integrate`].
 pub const SCHUR_SNAP: f64 = 64.0 * f64::EPSILON;
 

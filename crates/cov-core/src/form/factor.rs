@@ -27,9 +27,13 @@ use crate::linalg::{MAX, Small, sym_eigen};
 use crate::{AnyCov, AnySpectrum, Cov, CovError, Form, Spectrum};
 
 /// The factor's rank decision after a Schur update, on row norms (dimensionless): a row
-/// whose norm fell to at most `ROW_SNAP ×` its norm before holds rounding only and becomes
-/// exactly 0. `ROW_SNAP = √SCHUR_SNAP ≈ 1.2e-7`, so `Σ_aa` itself fell to at most
-/// [`SCHUR_SNAP`] of its value: the same decision as the covariance form, in Σ terms.
+/// whose norm fell to at most `ROW_SNAP ×` its norm before holds rounding only in its part
+/// orthogonal to the updated row, and that part becomes exactly 0. `ROW_SNAP = √SCHUR_SNAP
+/// ≈ 1.2e-7`, so `Σ_aa` itself fell to at most [`SCHUR_SNAP`] of its value: the same
+/// decision as the covariance form, in Σ terms. After Potter's update the row's component
+/// along the lobe's row is kept (it is scaled exactly, with no cancellation), so a small
+/// variance the parameters determine survives (a refocused 1e-9 m window); with a
+/// diffuse lobe or an integration that component is 0 and the whole row is.
 /// A finer threshold (`64 ε` on the row) was measured to keep accumulated rounding of
 /// 67 ε as "content", and a later integration along that noise removed 99.9995% of an
 /// unrelated axis (the row's noise lay along it).
@@ -545,18 +549,37 @@ fn potter<const N: usize>(l: &mut [[f64; N]; N], p: usize, s: f64) {
 }
 
 /// [`potter`] along axis `p`, then the clean-up: a row whose norm fell to at most
-/// [`ROW_SNAP`] of its norm before is rounding noise (the covariance form's decision, in
-/// Σ terms) and becomes exactly 0. Row `p` is exempt: Potter scales it, so a large drop is
-/// the lobe's information. The clean-up runs after every axis, so that a later axis never
+/// [`ROW_SNAP`] of its norm before holds, besides rounding noise, its component along row
+/// `p`. Potter scales that component by `√(s/m)` exactly as it scales row `p`, so it is
+/// recomputed as `c·L'_p` (`c` the row's coefficient on row `p` before), free of
+/// cancellation; the rest is noise and becomes exactly 0. Row `p` is exempt: Potter
+/// scales it, so a large drop is the lobe's information. The clean-up runs after every axis, so that a later axis never
 /// updates along a noise direction (a zero-`s` update along noise would remove a random
 /// part of every other row).
 #[inline]
 fn potter_axis<const N: usize>(l: &mut [[f64; N]; N], p: usize, s: f64) {
     let old = *l;
     potter(l, p, s);
+    // Row p before, scaled to unit largest entry (its direction; no overflow in a·a).
+    let scale = old[p].iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    if scale == 0.0 || !scale.is_finite() {
+        return; // potter changed nothing
+    }
+    let a = old[p].map(|v| v / scale);
+    let aa: f64 = a.iter().map(|v| v * v).sum();
     for i in 0..N {
         if i != p && cancelled(&l[i], &old[i]) {
-            l[i] = [0.0; N];
+            // Row i's component along row p, `c·L_p`, is scaled exactly as row p was
+            // (by √(s/m)): keep it, computed without cancellation as `c·L'_p`. What
+            // cancelled is the part orthogonal to row p, which the lobe does not touch
+            // and which is here below ROW_SNAP: rounding noise, dropped.
+            let c = a.iter().zip(&old[i]).map(|(x, y)| x * y).sum::<f64>() / aa / scale;
+            let row = l[p].map(|v| c * v);
+            l[i] = if row.iter().all(|v| v.is_finite()) {
+                row
+            } else {
+                [0.0; N]
+            };
         }
     }
 }
