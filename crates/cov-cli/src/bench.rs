@@ -175,10 +175,12 @@ fn check_args(a: &BenchArgs) -> Result<(Vec<Method>, Vec<f64>), String> {
     Ok((methods(&a.methods)?, budgets))
 }
 
-/// Creates (if needed) and checks a folder for writing.
+/// Creates (if needed, with its missing parents, as `mkdir -p`) and checks a folder for
+/// writing.
 fn folder(dir: &Path, what: &str) -> Result<(), String> {
     if !dir.is_dir() {
-        std::fs::create_dir(dir).map_err(|e| format!("{what} {}: cannot create it: {e}", dir.display()))?;
+        std::fs::create_dir_all(dir)
+            .map_err(|e| format!("{what} {}: cannot create it: {e}", dir.display()))?;
     }
     crate::render::check_output(&dir.join("probe.json"), "json")
 }

@@ -6,7 +6,8 @@ use common::covtrace;
 
 #[test]
 fn a_tiny_bench_writes_every_output_and_caches_its_reference() {
-    let dir = common::tmp("bench", "out");
+    // A folder whose parent does not exist yet: created as `mkdir -p` would.
+    let dir = common::tmp("bench", "out").join("cornell");
     let d = dir.to_str().expect("utf-8 path");
     let args = [
         "render-bench",
