@@ -560,19 +560,22 @@ fn potter<const N: usize>(l: &mut [[f64; N]; N], p: usize, s: f64) {
 fn potter_axis<const N: usize>(l: &mut [[f64; N]; N], p: usize, s: f64) {
     let old = *l;
     potter(l, p, s);
-    // Row p before, scaled to unit largest entry (its direction; no overflow in a·a).
-    let scale = old[p].iter().fold(0.0f64, |m, v| m.max(v.abs()));
-    if scale == 0.0 || !scale.is_finite() {
-        return; // potter changed nothing
-    }
-    let a = old[p].map(|v| v / scale);
-    let aa: f64 = a.iter().map(|v| v * v).sum();
+    // Row p before, scaled to unit largest entry (its direction; no overflow in a·a),
+    // with that scale and a·a: computed once, when a row first cancels.
+    let mut dir: Option<([f64; N], f64, f64)> = None;
     for i in 0..N {
         if i != p && cancelled(&l[i], &old[i]) {
+            let (a, scale, aa) = *dir.get_or_insert_with(|| {
+                let scale = old[p].iter().fold(0.0f64, |m, v| m.max(v.abs()));
+                let a = old[p].map(|v| v / scale);
+                (a, scale, a.iter().map(|v| v * v).sum())
+            });
             // Row i's component along row p, `c·L_p`, is scaled exactly as row p was
             // (by √(s/m)): keep it, computed without cancellation as `c·L'_p`. What
             // cancelled is the part orthogonal to row p, which the lobe does not touch
-            // and which is here below ROW_SNAP: rounding noise, dropped.
+            // and which is here below ROW_SNAP: rounding noise, dropped. (A row cancels
+            // only when row p had content, so `scale` and `aa` are > 0; a non-finite
+            // coefficient falls back to 0.)
             let c = a.iter().zip(&old[i]).map(|(x, y)| x * y).sum::<f64>() / aa / scale;
             let row = l[p].map(|v| c * v);
             l[i] = if row.iter().all(|v| v.is_finite()) {
