@@ -721,8 +721,15 @@ pub fn cases(long: usize) -> Vec<Case> {
 
 /// The report as text lines.
 pub fn report(outcomes: &[Outcome]) -> String {
+    // The case column is as wide as the longest name, so the columns stay aligned.
+    let w = outcomes
+        .iter()
+        .map(|o| o.name.chars().count())
+        .max()
+        .unwrap_or(0)
+        .max(4);
     let mut s = format!(
-        "{:<50} {:>6} {:>11} {:>11} {:>9} {:>11} {:>9} {:>8}\n",
+        "{:<w$} {:>6} {:>11} {:>11} {:>9} {:>11} {:>9} {:>8}\n",
         "case", "ops", "ours sqrt", "ours cov", "ours PSD", "plain", "plain PSD", "cond"
     );
     let fmt = |e: Option<f64>| e.map(|v| format!("{v:.2e}")).unwrap_or_else(|| "FAILED".into());
@@ -733,7 +740,7 @@ pub fn report(outcomes: &[Outcome]) -> String {
     };
     for o in outcomes {
         s.push_str(&format!(
-            "{:<50} {:>6} {:>11} {:>11} {:>9} {:>11} {:>9} {:>8.1e}\n",
+            "{:<w$} {:>6} {:>11} {:>11} {:>9} {:>11} {:>9} {:>8.1e}\n",
             o.name,
             o.ops,
             ours_cell(o, o.ours),
