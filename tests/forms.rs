@@ -12,7 +12,7 @@
 use cov_stiff::reference::Dense;
 use cov_stiff::rel_error;
 use covtrace::path::Path;
-use covtrace::{Cov, CovError, CovFactor, Form, Spectrum};
+use covtrace::{Chain, Cov, CovError, CovFactor, Form, Operator, Spectrum};
 use nalgebra::{DMatrix, SMatrix};
 use proptest::prelude::*;
 use twofloat::TwoFloat;
@@ -53,6 +53,30 @@ fn apply(s: &mut dyn Spectrum, op: Op) -> Result<(), CovError> {
         Op::Lobe2(a, b, q) => s.convolve(&[ax[a], ax[b]], &[q, 0.3 * q, 0.3 * q, 2.0 * q]),
         Op::Integrate(a) => s.integrate(&[ax[a]]),
     }
+}
+
+/// One op as an operator, for the compiled path (`Chain`'s fused program).
+#[derive(Debug)]
+struct Step(Op);
+
+impl Operator for Step {
+    fn apply(&self, s: &mut dyn Spectrum) -> Result<(), CovError> {
+        apply(s, self.0)
+    }
+}
+
+/// The chain's compiled result in `form` (its second evaluation, then a batch of one in
+/// covariance form, which takes the lane program), each checked against `check`.
+fn compiled<const N: usize>(ops: &[Op], c0: Cov<N>, form: Form, check: impl Fn(&Cov<N>, &str)) {
+    let mut chain = Chain::new();
+    for &op in ops {
+        chain.push(Step(op));
+    }
+    let _ = chain.eval_in(form, c0).unwrap();
+    check(&chain.eval_in(form, c0).unwrap(), "compiled");
+    let mut batch = vec![c0; 9];
+    assert!(chain.eval_batch(form, &mut batch).is_empty());
+    check(&batch[8], "batch");
 }
 
 fn reference(d: &mut Dense<TwoFloat>, op: Op) {
@@ -227,6 +251,16 @@ fn run_chain<const N: usize>(
             ec <= COV_SLACK * bound,
             "N={N} covariance: {ec:e} > {COV_SLACK} × bound {bound:e}, ops {ops:?}"
         );
+        // The compiled path (fused rule-1 runs, lanes) is held to its form's bound.
+        for (form, slack) in [(Form::SquareRoot, 1.0), (Form::Covariance, COV_SLACK)] {
+            compiled(&ops, c0, form, |c, how| {
+                let e = rel_error(&dense(c), &exact, &peak);
+                assert!(
+                    e <= slack * bound,
+                    "N={N} {how} {form:?}: {e:e} > {slack} × bound {bound:e}, ops {ops:?}"
+                );
+            });
+        }
     }
     (ef, ec, bound)
 }

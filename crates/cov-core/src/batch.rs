@@ -4,7 +4,8 @@
 //! [`LANES`] states are stored structure-of-arrays (entry by entry, state by state) so
 //! that each kernel runs as plain loops over the lanes, which the compiler vectorises.
 //! Every lane computes exactly what the scalar kernels compute (same operations in the
-//! same order), so a batch gives the same bits as [`Chain::eval_in`].
+//! same order), so a covariance batch gives the same bits as [`Chain::eval_in`]. A
+//! square-root batch runs the chain's compiled program state by state.
 
 use rayon::prelude::*;
 
@@ -67,7 +68,7 @@ impl Chain {
             .flat_map_iter(|(c, chunk)| {
                 let mut bad = Vec::new();
                 match &lanes {
-                    Some(prog) => self.run_lanes(tape, prog, chunk, c * CHUNK, &mut bad),
+                    Some(prog) => self.run_lanes(prog, chunk, c * CHUNK, &mut bad),
                     None => {
                         for (i, s) in chunk.iter_mut().enumerate() {
                             self.run_one(tape, form, s, c * CHUNK + i, &mut bad);
@@ -109,46 +110,48 @@ impl Chain {
         }
     }
 
+    /// A state the compiled path refused (an overflow): the checked path decides. It
+    /// reports the failing step, and the state is left as it was; or, if it succeeds
+    /// (the square-root program folds a window's variances at once, which rounds
+    /// differently from one fold per axis), its result is the state's.
     fn report_failure<const N: usize>(
         &self,
         form: Form,
-        s: &Cov<N>,
+        s: &mut Cov<N>,
         index: usize,
         bad: &mut Vec<(usize, CovError)>,
     ) {
         let checked = match form {
-            Form::Covariance => self.apply_checked(&mut s.clone()),
+            Form::Covariance => {
+                let mut c = *s;
+                self.apply_checked(&mut c).map(|()| c)
+            }
             Form::SquareRoot => {
                 let mut f = CovFactor::from_cov(s);
-                self.apply_checked(&mut f).and_then(|()| f.to_cov().map(|_| ()))
+                self.apply_checked(&mut f).and_then(|()| f.to_cov())
             }
         };
-        let e = match checked {
-            Err(e) => e,
-            // The checked path succeeded where the tape did not: impossible when the
-            // kernels agree; report it rather than hide it.
-            Ok(()) => CovError::NoTransport {
-                operator: "Chain::eval_batch".into(),
-                reason: "the compiled and the checked evaluation disagree".into(),
-            },
-        };
-        bad.push((index, e));
+        match checked {
+            Ok(c) => *s = c,
+            Err(e) => bad.push((index, e)),
+        }
     }
 
     /// Groups of [`LANES`] states in structure-of-arrays form through `prog` (the tape's
-    /// lane program); a ragged tail and failing lanes go through [`Chain::run_one`].
+    /// lane program); failing lanes go through the checked path.
     fn run_lanes<const N: usize>(
         &self,
-        tape: &Tape,
         prog: &[LaneInstr<N>],
         chunk: &mut [Cov<N>],
         base: usize,
         bad: &mut Vec<(usize, CovError)>,
     ) {
-        let done = chunk.len() - chunk.len() % LANES;
-        for (g, group) in chunk[..done].chunks_exact_mut(LANES).enumerate() {
+        // A ragged tail runs as a partial group (the spare lanes hold copies of its first
+        // state and are discarded), so every state takes the same arithmetic.
+        for (g, group) in chunk.chunks_mut(LANES).enumerate() {
             let mut a = LaneCov::<N>([[0.0; LANES]; 15]);
-            for (l, s) in group.iter().enumerate() {
+            for l in 0..LANES {
+                let s = &group[l.min(group.len() - 1)];
                 for (e, v) in s.packed().iter().enumerate() {
                     a.0[e][l] = *v;
                 }
@@ -175,9 +178,6 @@ impl Chain {
                 }
                 *s = c;
             }
-        }
-        for (i, s) in chunk[done..].iter_mut().enumerate() {
-            self.run_one(tape, Form::Covariance, s, base + done + i, bad);
         }
     }
 }

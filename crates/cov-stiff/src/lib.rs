@@ -98,6 +98,10 @@ pub struct Outcome {
     pub ours: Option<f64>,
     /// The same in the covariance form (`None`: an error).
     pub ours_cov: Option<f64>,
+    /// The compiled path's errors (square root, covariance): the chain's second
+    /// evaluation, which runs its compiled program (fused rule-1 runs in covariance
+    /// form). `None`: an error.
+    pub compiled: (Option<f64>, Option<f64>),
     /// Ours returned a non-PSD Σ.
     pub ours_non_psd: bool,
     /// Ours' error message, if it failed.
@@ -254,14 +258,27 @@ pub fn plain_eval(case: &Case) -> Option<DMatrix<f64>> {
 /// # Errors
 /// An operator's error (e.g. overflow, total internal reflection).
 pub fn ours_eval(case: &Case, form: Form) -> Result<DMatrix<f64>, CovError> {
+    ours_eval_times(case, form, 1)
+}
+
+/// [`ours_eval`] on the compiled path: the same chain evaluated twice, the second time
+/// through its compiled program (what a renderer that reuses a chain runs).
+///
+/// # Errors
+/// As [`ours_eval`].
+pub fn ours_eval_compiled(case: &Case, form: Form) -> Result<DMatrix<f64>, CovError> {
+    ours_eval_times(case, form, 2)
+}
+
+fn ours_eval_times(case: &Case, form: Form, times: usize) -> Result<DMatrix<f64>, CovError> {
     match case.n {
-        2 => ours_n::<2>(case, form),
-        3 => ours_n::<3>(case, form),
-        _ => ours_n::<4>(case, form),
+        2 => ours_n::<2>(case, form, times),
+        3 => ours_n::<3>(case, form, times),
+        _ => ours_n::<4>(case, form, times),
     }
 }
 
-fn ours_n<const N: usize>(case: &Case, form: Form) -> Result<DMatrix<f64>, CovError> {
+fn ours_n<const N: usize>(case: &Case, form: Form, times: usize) -> Result<DMatrix<f64>, CovError> {
     let m = nalgebra::SMatrix::<f64, N, N>::from_fn(|i, j| case.start[i * N + j]);
     let start = Cov::<N>::from_matrix(&m)?;
     let mut chain = Chain::new();
@@ -285,7 +302,10 @@ fn ours_n<const N: usize>(case: &Case, form: Form) -> Result<DMatrix<f64>, CovEr
             }
         }
     }
-    let c = chain.eval_in(form, start)?;
+    let mut c = chain.eval_in(form, start)?;
+    for _ in 1..times {
+        c = chain.eval_in(form, start)?;
+    }
     if !c.validity().psd {
         return Err(CovError::NotPsd {
             min_eigenvalue: c.validity().min_eigenvalue,
@@ -369,6 +389,13 @@ pub fn run_case(case: &Case) -> Outcome {
     };
     let ours = ours_in(Form::SquareRoot);
     let ours_cov = ours_in(Form::Covariance);
+    let compiled_in = |form| {
+        ours_eval_compiled(case, form)
+            .ok()
+            .filter(is_psd)
+            .map(|m| rel_error(&m, &r, &peak))
+    };
+    let compiled = (compiled_in(Form::SquareRoot), compiled_in(Form::Covariance));
     let mut perturbed = case.clone();
     for (k, v) in perturbed.start.iter_mut().enumerate() {
         *v *= 1.0 + 1e-12 * if k % 3 == 0 { 1.0 } else { -0.7 };
@@ -387,6 +414,7 @@ pub fn run_case(case: &Case) -> Outcome {
         factor_only: case.factor_only,
         ours,
         ours_cov,
+        compiled,
         ours_non_psd,
         ours_error,
         plain,

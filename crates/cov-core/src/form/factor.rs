@@ -428,7 +428,11 @@ impl<const N: usize> CovFactor<N> {
             }
             return new;
         }
-        lq(&mut m, 0, N, N, cols);
+        match cols - N {
+            1 => lq_fold::<N, 1>(&mut m),
+            2 => lq_fold::<N, 2>(&mut m),
+            _ => lq(&mut m, 0, N, N, cols),
+        }
         let mut new = [[0.0; N]; N];
         for i in 0..N {
             new[i].copy_from_slice(&m[i][..N]);
@@ -627,42 +631,73 @@ fn row_norm<const N: usize>(r: &[f64; N]) -> f64 {
 /// Each reflection is built from the row scaled by its largest entry, so rows anywhere in
 /// `1e-300 … 1e300` neither overflow nor underflow; a zero row is skipped.
 fn lq<const R: usize>(m: &mut [[f64; W]; R], r0: usize, r1: usize, rows: usize, cols: usize) {
+    lq_body(m, r0, r1, rows, cols);
+}
+
+/// [`lq`] of a fold (`N` rows, `N + K` columns) with every size and row index a
+/// constant, so that the compiler unrolls each reflection: the same operations in the
+/// same order (the same bits), fewer instructions.
+fn lq_fold<const N: usize, const K: usize>(m: &mut Work) {
+    householder_row(m, 0, N, N + K);
+    if N > 1 {
+        householder_row(m, 1, N, N + K);
+    }
+    if N > 2 {
+        householder_row(m, 2, N, N + K);
+    }
+    if N > 3 {
+        householder_row(m, 3, N, N + K);
+    }
+    if N > 4 {
+        householder_row(m, 4, N, N + K);
+    }
+}
+
+/// The body of [`lq`]: one reflection per row.
+#[inline(always)]
+fn lq_body<const R: usize>(m: &mut [[f64; W]; R], r0: usize, r1: usize, rows: usize, cols: usize) {
     for r in r0..r1 {
-        let mut v = [0.0; W];
-        v[r..cols].copy_from_slice(&m[r][r..cols]);
-        // Scale only when the plain sum of squares would overflow or underflow.
-        let mut scale = 1.0;
-        let mut sq: f64 = v[r..cols].iter().map(|x| x * x).sum();
-        if !(sq.is_finite() && sq > 1e-290) {
-            scale = v[r..cols].iter().fold(0.0f64, |a, x| a.max(x.abs()));
-            if scale == 0.0 {
-                continue;
-            }
-            let inv = 1.0 / scale;
-            for x in v[r..cols].iter_mut() {
-                *x *= inv;
-            }
-            sq = v[r..cols].iter().map(|x| x * x).sum();
+        householder_row(m, r, rows, cols);
+    }
+}
+
+/// The reflection of [`lq`] for row `r` (inlined where `r` is a constant).
+#[inline(always)]
+fn householder_row<const R: usize>(m: &mut [[f64; W]; R], r: usize, rows: usize, cols: usize) {
+    let mut v = [0.0; W];
+    v[r..cols].copy_from_slice(&m[r][r..cols]);
+    // Scale only when the plain sum of squares would overflow or underflow.
+    let mut scale = 1.0;
+    let mut sq: f64 = v[r..cols].iter().map(|x| x * x).sum();
+    if !(sq.is_finite() && sq > 1e-290) {
+        scale = v[r..cols].iter().fold(0.0f64, |a, x| a.max(x.abs()));
+        if scale == 0.0 {
+            return;
         }
-        let norm = sq.sqrt();
-        // α = −sign(v_r)·‖v‖ avoids cancellation in v_r − α.
-        let alpha = if v[r] >= 0.0 { -norm } else { norm };
-        v[r] -= alpha;
-        let vv: f64 = v[r..cols].iter().map(|x| x * x).sum();
-        if vv == 0.0 {
-            continue;
+        let inv = 1.0 / scale;
+        for x in v[r..cols].iter_mut() {
+            *x *= inv;
         }
-        let two_over = 2.0 / vv;
-        for row in m.iter_mut().take(rows).skip(r + 1) {
-            let t = two_over * (r..cols).map(|c| row[c] * v[c]).sum::<f64>();
-            for c in r..cols {
-                row[c] -= t * v[c];
-            }
+        sq = v[r..cols].iter().map(|x| x * x).sum();
+    }
+    let norm = sq.sqrt();
+    // α = −sign(v_r)·‖v‖ avoids cancellation in v_r − α.
+    let alpha = if v[r] >= 0.0 { -norm } else { norm };
+    v[r] -= alpha;
+    let vv: f64 = v[r..cols].iter().map(|x| x * x).sum();
+    if vv == 0.0 {
+        return;
+    }
+    let two_over = 2.0 / vv;
+    for row in &mut m[r + 1..rows] {
+        let t = two_over * (r..cols).map(|c| row[c] * v[c]).sum::<f64>();
+        for c in r..cols {
+            row[c] -= t * v[c];
         }
-        m[r][r] = alpha * scale;
-        for c in (r + 1)..cols {
-            m[r][c] = 0.0;
-        }
+    }
+    m[r][r] = alpha * scale;
+    for c in (r + 1)..cols {
+        m[r][c] = 0.0;
     }
 }
 
