@@ -49,6 +49,22 @@ impl<const N: usize> Cov<N> {
         i * N - i * (i + 1) / 2 + j
     }
 
+    /// [`Cov::idx`] as a table, for indices known only at run time (the checked kernels):
+    /// one load instead of a swap, a multiply and a shift. Entries beyond `N` are unused.
+    const IX: [[u8; MAX]; MAX] = {
+        let mut t = [[0; MAX]; MAX];
+        let mut i = 0;
+        while i < N && i < MAX {
+            let mut j = 0;
+            while j < N && j < MAX {
+                t[i][j] = Self::idx(i, j) as u8;
+                j += 1;
+            }
+            i += 1;
+        }
+        t
+    };
+
     /// Σ = 0: a field constant along every axis (no frequency content).
     pub fn zeros() -> Self {
         #[allow(clippy::let_unit_value)]
@@ -81,7 +97,7 @@ impl<const N: usize> Cov<N> {
     #[inline(always)]
     pub fn get(&self, i: usize, j: usize) -> f64 {
         assert!(i < N && j < N, "index ({i},{j}) out of range for N = {N}");
-        self.p[Self::idx(i, j)]
+        self.p[Self::IX[i][j] as usize]
     }
 
     /// Sets `Σ_ij = Σ_ji = value` by index. Indices must be `< N`. This does not check
@@ -89,7 +105,7 @@ impl<const N: usize> Cov<N> {
     #[inline(always)]
     pub fn set(&mut self, i: usize, j: usize, value: f64) {
         assert!(i < N && j < N, "index ({i},{j}) out of range for N = {N}");
-        self.p[Self::idx(i, j)] = value;
+        self.p[Self::IX[i][j] as usize] = value;
     }
 
     /// Entry `Σ_ab` by axis.
