@@ -28,7 +28,9 @@ const fn ix<const N: usize>(i: usize, j: usize) -> usize {
 
 impl Chain {
     /// Evaluates the chain on every state in place, in `form`, in parallel: the
-    /// batched form of [`Chain::eval_in`], with the same result bits per state.
+    /// batched form of [`Chain::eval_in`], with the result bits of its compiled path (a
+    /// chain's evaluations from the second on; the first runs checked, which in
+    /// square-root form can differ in rounding where a window adds several variances).
     ///
     /// Returns the states that failed, with their error (as [`Chain::eval_in`] reports
     /// it: step, operator, value); those states are left as they were.

@@ -7,6 +7,15 @@
 //! is repeated in checked mode by the caller, which finds and reports the failing step
 //! exactly as before.
 //!
+//! A chain runs its tape as a program lowered once for the concrete form: each kernel a
+//! function with constant indices; the two kernels an operator makes on the transverse
+//! planes (x, u) and (y, v) (travel, curvature, a frame rotation, a mirror, a window) one
+//! call, with the same operations in the same order; and in square-root form the
+//! variances a window adds on several axes one fold instead of one per axis (the same Σ
+//! to rounding, within the stiff suite's and the random-chain test's bounds). A tape run
+//! through [`Tape::run_cov`] or [`Tape::run_factor`] goes kernel by kernel and gives the
+//! checked kernels' bits.
+//!
 //! Recording needs no special support from operators: a tape records by applying each
 //! operator to a [`Recorder`], a [`Spectrum`] whose raw kernels append to the tape. An
 //! operator whose kernel calls depend on Σ itself (it reads [`Spectrum::cov`] or takes

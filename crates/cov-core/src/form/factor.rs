@@ -152,11 +152,14 @@ impl<const N: usize> CovFactor<N> {
                     g[y][k] = a[y][p] / r;
                 }
             }
-            for y in 0..na {
-                for z in 0..na {
-                    if !done[y] && !done[z] {
-                        a[y][z] -= g[y][k] * g[z][k];
-                    }
+            // The Schur update of the rows not done, written without branches over the
+            // whole N × N array so that it unrolls: rows and columns done before have
+            // `g = 0` (left as they were), rows beyond `na` are 0, and row and column `p`
+            // are never read again. The entries read later get the same operations.
+            for y in 0..N {
+                let gy = g[y][k];
+                for z in 0..N {
+                    a[y][z] -= gy * g[z][k];
                 }
             }
         }
