@@ -11,7 +11,9 @@
 //!   baseline; operators built per ray and applied checked; the same recorded on a
 //!   reused `Tape` and run. Fixed parameters: the baseline with coefficients computed
 //!   once; the public `Chain::apply` (compiled tape); `Chain::eval_batch` on one core
-//!   and on every core.
+//!   and on every core. Per-ray parameters, batched: `eval_batch_with` building and
+//!   applying each state's operators, on one core and on every core, next to the
+//!   per-ray baseline over the same 4,096 states.
 
 use std::f64::consts::PI;
 use std::hint::black_box;
@@ -375,6 +377,42 @@ fn bounce_n<const N: usize>(c: &mut Criterion, rng: &mut ChaCha8Rng) {
             })
         });
     }
+    // Per-ray parameters, batched: each state's operators built and applied in parallel.
+    for (name, form) in [
+        ("covariance", Form::Covariance),
+        ("square root", Form::SquareRoot),
+    ] {
+        let per_ray = |i: usize, s: &mut dyn covtrace::Spectrum| {
+            let ops = Ops::new(&rays[i % rays.len()], N);
+            for op in ops.list().into_iter().flatten() {
+                op.apply(s)?;
+            }
+            Ok(())
+        };
+        for (threads, pool) in [("1 thread", Some(&one)), ("all threads", None)] {
+            g.bench_function(format!("per-ray: eval_batch_with ({name}, {threads})"), |b| {
+                b.iter(|| {
+                    let mut states = many.clone();
+                    let failed = match pool {
+                        Some(p) => p.install(|| covtrace::eval_batch_with(form, &mut states, per_ray)),
+                        None => covtrace::eval_batch_with(form, &mut states, per_ray),
+                    };
+                    black_box((failed.len(), states[0].get(0, 0)))
+                })
+            });
+        }
+    }
+    g.bench_function("per-ray: baseline (4,096 states)", |b| {
+        b.iter(|| {
+            let mut acc = 0.0;
+            for (i, cv) in many.iter().enumerate() {
+                let mut p = packed(cv);
+                baseline::bounce(&mut p, &rays[i % rays.len()]);
+                acc += p.p[0];
+            }
+            black_box(acc)
+        })
+    });
     g.bench_function("fixed: baseline (4,096 states)", |b| {
         b.iter(|| {
             let mut acc = 0.0;

@@ -319,3 +319,39 @@ fn batch_reports_failing_states_by_index() {
     let want = chain.eval_in(Form::Covariance, before[1099]).unwrap();
     assert_eq!(states[1099], want);
 }
+
+#[test]
+fn per_state_batches_match_each_chain() {
+    // 1,100 states (chunks and a tail), each through its own bounce; state 5 overflows.
+    let seed: Vec<f64> = (0..25).map(|i| (i as f64 * 0.61).cos()).collect();
+    let chains: Vec<Chain> = (0..1100)
+        .map(|i| {
+            let t = i as f64 / 1100.0;
+            let c = bounce(3.0 * t - 1.5, 0.3 + 0.6 * t, 0.9 - 0.5 * t, 6.0 * t);
+            if i == 5 {
+                Chain::new().with(K(1, 0.0, 1e300)).with(c)
+            } else {
+                c
+            }
+        })
+        .collect();
+    for form in [Form::Covariance, Form::SquareRoot] {
+        let mut states = vec![start::<4>(&seed); 1100];
+        states[5] = Cov::<4>::gaussian([1e-150, 1.0, 1.0, 1.0]).unwrap();
+        let before = states.clone();
+        let failed = covtrace::eval_batch_with(form, &mut states, |i, s| chains[i].apply(s));
+        assert_eq!(failed.len(), 1, "{form:?}");
+        assert_eq!(failed[0].0, 5);
+        let want = chains[5].eval_in(form, before[5]).unwrap_err();
+        assert_eq!(failed[0].1.to_string(), want.to_string());
+        assert_eq!(states[5], before[5], "a failed state is left as it was");
+        for i in [0, 511, 512, 1099] {
+            // Each chain ran once inside the batch: its checked path.
+            assert_eq!(
+                states[i],
+                checked(&chains[i], form, before[i]).unwrap(),
+                "{form:?} {i}"
+            );
+        }
+    }
+}

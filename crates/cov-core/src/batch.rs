@@ -10,7 +10,7 @@
 use rayon::prelude::*;
 
 use crate::tape::{Fn2, Kernel, index_fn, pair_fn};
-use crate::{Chain, Cov, CovError, CovFactor, Form, Tape};
+use crate::{Chain, Cov, CovError, CovFactor, Form, Spectrum, Tape};
 
 /// States stored side by side in the structure-of-arrays groups.
 pub const LANES: usize = 8;
@@ -182,6 +182,76 @@ impl Chain {
             }
         }
     }
+}
+
+/// Evaluates every state through its own operators, in place, in `form`, in parallel
+/// (rayon, chunks of [`CHUNK`]): the batch with per-state parameters, what a renderer
+/// calls for a tile of paths whose operators differ from path to path. `ops(i, s)`
+/// applies state `i`'s operators to `s` (built on the stack: nothing is allocated per
+/// state). Each state runs the checked kernels, as one [`Chain::eval_in`] does.
+///
+/// Returns the states that failed with what `ops` reported, or an overflow if `ops`
+/// left Σ non-finite; those states are left as they were.
+///
+/// ```
+/// use cov_core::{Axis, Cov, CovError, Form, Spectrum, eval_batch_with};
+/// // Travel by a distance of its own per state.
+/// let distances: Vec<f64> = (0..100).map(|i| 0.1 * i as f64).collect();
+/// let mut states = vec![Cov::<2>::gaussian([0.5, 1.0])?; 100];
+/// let failed = eval_batch_with(Form::Covariance, &mut states, |i, s: &mut dyn Spectrum| {
+///     s.shear(Axis::X, Axis::U, -distances[i])
+/// });
+/// assert!(failed.is_empty());
+/// assert_eq!(states[0].get(0, 0), 0.5);
+/// assert!(states[99].get(0, 0) > 10.0);
+/// # Ok::<(), CovError>(())
+/// ```
+pub fn eval_batch_with<const N: usize, F>(form: Form, states: &mut [Cov<N>], ops: F) -> Vec<(usize, CovError)>
+where
+    F: Fn(usize, &mut dyn Spectrum) -> Result<(), CovError> + Sync,
+{
+    let one = |i: usize, s: &mut Cov<N>| -> Result<(), CovError> {
+        let finite = |sp: &dyn Spectrum| match sp.first_non_finite() {
+            None => Ok(()),
+            Some((row, col, value)) => Err(CovError::Overflow {
+                operator: "eval_batch_with".into(),
+                row,
+                col,
+                value,
+            }),
+        };
+        match form {
+            Form::Covariance => {
+                let mut c = *s;
+                ops(i, &mut c)?;
+                finite(&c)?;
+                *s = c;
+            }
+            Form::SquareRoot => {
+                let mut f = CovFactor::from_cov(s);
+                ops(i, &mut f)?;
+                finite(&f)?;
+                *s = f.to_cov()?;
+            }
+        }
+        Ok(())
+    };
+    let mut failed: Vec<(usize, CovError)> = states
+        .par_chunks_mut(CHUNK)
+        .enumerate()
+        .flat_map_iter(|(c, chunk)| {
+            let mut bad = Vec::new();
+            for (k, s) in chunk.iter_mut().enumerate() {
+                let i = c * CHUNK + k;
+                if let Err(e) = one(i, s) {
+                    bad.push((i, e));
+                }
+            }
+            bad
+        })
+        .collect();
+    failed.sort_by_key(|(i, _)| *i);
+    failed
 }
 
 /// Lanes of one layout, for the constant-index lane kernels.
