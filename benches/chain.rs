@@ -17,6 +17,7 @@
 
 use std::f64::consts::PI;
 use std::hint::black_box;
+use std::time::{Duration, Instant};
 
 use covtrace::brdf::{Brdf, Lobe};
 use covtrace::curvature::Curvature;
@@ -24,7 +25,7 @@ use covtrace::occlusion::Window;
 use covtrace::projection::{Mirror, Project, RotateFrame, Unproject};
 use covtrace::travel::Travel;
 use covtrace::{Chain, Cov, CovFactor, Form, Operator, Spectrum, Tape};
-use criterion::{Criterion, Throughput, criterion_group, criterion_main};
+use criterion::{BatchSize, Bencher, Criterion, Throughput, criterion_group, criterion_main};
 use glam::DVec3;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
@@ -176,45 +177,52 @@ fn same_as_library<const N: usize>(covs: &[Cov<N>], rays: &[Ray]) {
     }
 }
 
+/// Times `f` on every state of a fresh copy of `input`, in place (the copy is made outside
+/// the timing, and every state's full result is kept: nothing the library or the
+/// baseline computes can be dropped as dead code).
+fn each<T: Clone>(b: &mut Bencher<'_>, input: &[T], mut f: impl FnMut(usize, &mut T)) {
+    b.iter_batched_ref(
+        || input.to_vec(),
+        |work| {
+            for (i, s) in work.iter_mut().enumerate() {
+                f(i, s);
+            }
+            black_box(&*work);
+        },
+        BatchSize::SmallInput,
+    )
+}
+
+/// The baseline's packed copies of `covs`.
+fn packs<const N: usize>(covs: &[Cov<N>]) -> Vec<Packed<N>> {
+    covs.iter().map(packed).collect()
+}
+
 fn ops(c: &mut Criterion, rng: &mut ChaCha8Rng) {
     let covs = random_covs::<4>(rng);
     let facs: Vec<CovFactor<4>> = covs.iter().map(CovFactor::from_cov).collect();
     let rays = rays(rng);
     let mut g = c.benchmark_group("chain/op/N=4");
     g.throughput(Throughput::Elements(BATCH as u64));
+    let base = packs(&covs);
     macro_rules! op {
         ($name:expr, |$p:ident, $r:ident| $base:expr, |$rr:ident| $lib:expr) => {
             g.bench_function(concat!($name, ": baseline"), |b| {
-                b.iter(|| {
-                    let mut acc = 0.0;
-                    for (cv, $r) in covs.iter().zip(&rays) {
-                        let mut $p = packed(cv);
-                        $base;
-                        acc += $p.p[9];
-                    }
-                    black_box(acc)
+                each(b, &base, |i, $p| {
+                    let $r = &rays[i];
+                    $base;
                 })
             });
             g.bench_function(concat!($name, ": Cov<4>"), |b| {
-                b.iter(|| {
-                    let mut acc = 0.0;
-                    for (cv, $rr) in covs.iter().zip(&rays) {
-                        let mut x = *cv;
-                        let _ = black_box($lib.apply(&mut x));
-                        acc += x.get(3, 3);
-                    }
-                    black_box(acc)
+                each(b, &covs, |i, x| {
+                    let $rr = &rays[i];
+                    let _ = black_box($lib.apply(x));
                 })
             });
             g.bench_function(concat!($name, ": CovFactor<4>"), |b| {
-                b.iter(|| {
-                    let mut acc = 0.0;
-                    for (f, $rr) in facs.iter().zip(&rays) {
-                        let mut x = *f;
-                        let _ = black_box($lib.apply(&mut x));
-                        acc += x.rows()[3][3];
-                    }
-                    black_box(acc)
+                each(b, &facs, |i, x| {
+                    let $rr = &rays[i];
+                    let _ = black_box($lib.apply(x));
                 })
             });
         };
@@ -256,41 +264,22 @@ fn ops(c: &mut Criterion, rng: &mut ChaCha8Rng) {
 fn bounce_n<const N: usize>(c: &mut Criterion, rng: &mut ChaCha8Rng) {
     let covs = random_covs::<N>(rng);
     let facs: Vec<CovFactor<N>> = covs.iter().map(CovFactor::from_cov).collect();
+    let base = packs(&covs);
     let rays = rays(rng);
     same_as_library(&covs, &rays);
     let mut g = c.benchmark_group(format!("chain/bounce/N={N}"));
     g.throughput(Throughput::Elements(BATCH as u64));
     g.bench_function("per-ray: baseline", |b| {
-        b.iter(|| {
-            let mut acc = 0.0;
-            for (cv, r) in covs.iter().zip(&rays) {
-                let mut p = packed(cv);
-                baseline::bounce(&mut p, r);
-                acc += p.p[0];
-            }
-            black_box(acc)
-        })
+        each(b, &base, |i, p| baseline::bounce(p, &rays[i]))
     });
     g.bench_function("per-ray: operators applied (covariance)", |b| {
-        b.iter(|| {
-            let mut acc = 0.0;
-            for (cv, r) in covs.iter().zip(&rays) {
-                let mut x = *cv;
-                black_box(Ops::new(r, N).apply(&mut x));
-                acc += x.get(0, 0);
-            }
-            black_box(acc)
+        each(b, &covs, |i, x| {
+            black_box(Ops::new(&rays[i], N).apply(x));
         })
     });
     g.bench_function("per-ray: operators applied (square root)", |b| {
-        b.iter(|| {
-            let mut acc = 0.0;
-            for (f, r) in facs.iter().zip(&rays) {
-                let mut x = *f;
-                black_box(Ops::new(r, N).apply(&mut x));
-                acc += x.rows()[0][0];
-            }
-            black_box(acc)
+        each(b, &facs, |i, x| {
+            black_box(Ops::new(&rays[i], N).apply(x));
         })
     });
     for (name, form) in [
@@ -299,83 +288,72 @@ fn bounce_n<const N: usize>(c: &mut Criterion, rng: &mut ChaCha8Rng) {
     ] {
         g.bench_function(format!("per-ray: recorded on a Tape ({name})"), |b| {
             let mut tape = Tape::new(N, form).expect("layout");
-            b.iter(|| {
-                let mut acc = 0.0;
-                for (i, (cv, r)) in covs.iter().zip(&rays).enumerate() {
-                    tape.clear();
-                    let ops = Ops::new(r, N);
-                    for op in ops.list().into_iter().flatten() {
-                        tape.record(op).expect("recordable");
-                    }
-                    acc += match form {
-                        Form::Covariance => tape.run_cov(*cv).map_or(0.0, |x| x.get(0, 0)),
-                        Form::SquareRoot => tape.run_factor(facs[i]).map_or(0.0, |x| x.rows()[0][0]),
-                    };
+            each(b, &covs, |i, x| {
+                tape.clear();
+                let ops = Ops::new(&rays[i], N);
+                for op in ops.list().into_iter().flatten() {
+                    tape.record(op).expect("recordable");
                 }
-                black_box(acc)
+                match form {
+                    Form::Covariance => *x = tape.run_cov(*x).unwrap_or(*x),
+                    Form::SquareRoot => {
+                        black_box(tape.run_factor(facs[i]));
+                    }
+                }
             })
         });
     }
     let fixed = Fixed::new(&rays[0]);
-    g.bench_function("fixed: baseline", |b| {
-        b.iter(|| {
-            let mut acc = 0.0;
-            for cv in &covs {
-                let mut p = packed(cv);
-                fixed.run(&mut p);
-                acc += p.p[0];
-            }
-            black_box(acc)
-        })
-    });
+    g.bench_function("fixed: baseline", |b| each(b, &base, |_, p| fixed.run(p)));
     let chain = Ops::new(&rays[0], N).chain();
     g.bench_function("fixed: Chain::apply (covariance)", |b| {
-        b.iter(|| {
-            let mut acc = 0.0;
-            for cv in &covs {
-                let mut x = *cv;
-                black_box(chain.apply(&mut x).is_ok());
-                acc += x.get(0, 0);
-            }
-            black_box(acc)
+        each(b, &covs, |_, x| {
+            black_box(chain.apply(x).is_ok());
         })
     });
     g.bench_function("fixed: Chain::apply (square root)", |b| {
-        b.iter(|| {
-            let mut acc = 0.0;
-            for f in &facs {
-                let mut x = *f;
-                black_box(chain.apply(&mut x).is_ok());
-                acc += x.rows()[0][0];
-            }
-            black_box(acc)
+        each(b, &facs, |_, x| {
+            black_box(chain.apply(x).is_ok());
         })
     });
     // Batches: 4,096 states per call (16 × the scalar rows' 256; compare throughputs).
     let many: Vec<Cov<N>> = (0..16).flat_map(|_| covs.iter().copied()).collect();
+    let many_base = packs(&many);
     g.throughput(Throughput::Elements(many.len() as u64));
-    let one = rayon::ThreadPoolBuilder::new()
-        .num_threads(1)
-        .build()
-        .expect("pool");
+    // Batches run inside a pool (one worker, or one per core), a whole sample per
+    // `install`: what is timed is the batch, not handing it to another thread.
+    let pool = |threads| {
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .expect("pool")
+    };
+    let pools = [("1 thread", pool(1)), ("all threads", pool(0))];
+    let batch =
+        |b: &mut Bencher<'_>, pool: &rayon::ThreadPool, run: &(dyn Fn(&mut [Cov<N>]) -> usize + Sync)| {
+            b.iter_custom(|iters| {
+                pool.install(|| {
+                    let mut total = Duration::ZERO;
+                    for _ in 0..iters {
+                        let mut states = many.clone();
+                        let t = Instant::now();
+                        black_box(run(&mut states));
+                        total += t.elapsed();
+                        black_box(&states);
+                    }
+                    total
+                })
+            })
+        };
     for (name, form) in [
         ("covariance", Form::Covariance),
         ("square root", Form::SquareRoot),
     ] {
-        g.bench_function(format!("fixed: Chain::eval_batch ({name}, 1 thread)"), |b| {
-            b.iter(|| {
-                let mut states = many.clone();
-                let failed = one.install(|| chain.eval_batch(form, &mut states));
-                black_box((failed.len(), states[0].get(0, 0)))
-            })
-        });
-        g.bench_function(format!("fixed: Chain::eval_batch ({name}, all threads)"), |b| {
-            b.iter(|| {
-                let mut states = many.clone();
-                let failed = chain.eval_batch(form, &mut states);
-                black_box((failed.len(), states[0].get(0, 0)))
-            })
-        });
+        for (threads, p) in &pools {
+            g.bench_function(format!("fixed: Chain::eval_batch ({name}, {threads})"), |b| {
+                batch(b, p, &|s| chain.eval_batch(form, s).len())
+            });
+        }
     }
     // Per-ray parameters, batched: each state's operators built and applied in parallel.
     for (name, form) in [
@@ -389,40 +367,17 @@ fn bounce_n<const N: usize>(c: &mut Criterion, rng: &mut ChaCha8Rng) {
             }
             Ok(())
         };
-        for (threads, pool) in [("1 thread", Some(&one)), ("all threads", None)] {
+        for (threads, p) in &pools {
             g.bench_function(format!("per-ray: eval_batch_with ({name}, {threads})"), |b| {
-                b.iter(|| {
-                    let mut states = many.clone();
-                    let failed = match pool {
-                        Some(p) => p.install(|| covtrace::eval_batch_with(form, &mut states, per_ray)),
-                        None => covtrace::eval_batch_with(form, &mut states, per_ray),
-                    };
-                    black_box((failed.len(), states[0].get(0, 0)))
-                })
+                batch(b, p, &|s| covtrace::eval_batch_with(form, s, per_ray).len())
             });
         }
     }
     g.bench_function("per-ray: baseline (4,096 states)", |b| {
-        b.iter(|| {
-            let mut acc = 0.0;
-            for (i, cv) in many.iter().enumerate() {
-                let mut p = packed(cv);
-                baseline::bounce(&mut p, &rays[i % rays.len()]);
-                acc += p.p[0];
-            }
-            black_box(acc)
-        })
+        each(b, &many_base, |i, p| baseline::bounce(p, &rays[i % rays.len()]))
     });
     g.bench_function("fixed: baseline (4,096 states)", |b| {
-        b.iter(|| {
-            let mut acc = 0.0;
-            for cv in &many {
-                let mut p = packed(cv);
-                fixed.run(&mut p);
-                acc += p.p[0];
-            }
-            black_box(acc)
-        })
+        each(b, &many_base, |_, p| fixed.run(p))
     });
     g.finish();
 }

@@ -9,11 +9,13 @@
 
 use rayon::prelude::*;
 
-use crate::tape::{Fn2, Kernel, index_fn, pair_fn};
+use crate::tape::Kernel;
 use crate::{Chain, Cov, CovError, CovFactor, Form, Spectrum, Tape};
 
-/// States stored side by side in the structure-of-arrays groups.
-pub const LANES: usize = 8;
+/// States stored side by side in a structure-of-arrays group: each entry of Σ is one
+/// contiguous array over the group's states (at most 30 KB for layout 5, within a
+/// core's first-level cache).
+pub const LANES: usize = 256;
 
 /// States per parallel task.
 pub const CHUNK: usize = 512;
@@ -140,46 +142,18 @@ impl Chain {
     }
 
     /// Groups of [`LANES`] states in structure-of-arrays form through `prog` (the tape's
-    /// lane program); failing lanes go through the checked path.
+    /// lane program, [`run_chunk`]); failing lanes go through the checked path.
     fn run_lanes<const N: usize>(
         &self,
-        prog: &[LaneInstr<N>],
+        prog: &[LaneOp],
         chunk: &mut [Cov<N>],
         base: usize,
         bad: &mut Vec<(usize, CovError)>,
     ) {
-        // A ragged tail runs as a partial group (the spare lanes hold copies of its first
-        // state and are discarded), so every state takes the same arithmetic.
-        for (g, group) in chunk.chunks_mut(LANES).enumerate() {
-            let mut a = LaneCov::<N>([[0.0; LANES]; 15]);
-            for l in 0..LANES {
-                let s = &group[l.min(group.len() - 1)];
-                for (e, v) in s.packed().iter().enumerate() {
-                    a.0[e][l] = *v;
-                }
-            }
-            let mut poisoned = [false; LANES];
-            for (f, x, y, check) in prog {
-                if *check {
-                    // As the scalar tape: a lobe may hide an ∞, so check before it.
-                    mark_non_finite::<N>(&a.0, &mut poisoned);
-                }
-                f(&mut a, *x, *y);
-            }
-            mark_non_finite::<N>(&a.0, &mut poisoned);
-            for (l, s) in group.iter_mut().enumerate() {
-                if poisoned[l] {
-                    self.report_failure(Form::Covariance, s, base + g * LANES + l, bad);
-                    continue;
-                }
-                let mut c = Cov::<N>::zeros();
-                for i in 0..N {
-                    for j in i..N {
-                        c.set(i, j, a.0[ix::<N>(i, j)][l]);
-                    }
-                }
-                *s = c;
-            }
+        let mut poisoned = Vec::new();
+        run_chunk::<N>(prog, chunk, &mut poisoned);
+        for i in poisoned {
+            self.report_failure(Form::Covariance, &mut chunk[i], base + i, bad);
         }
     }
 }
@@ -254,49 +228,165 @@ where
     failed
 }
 
-/// Lanes of one layout, for the constant-index lane kernels.
-struct LaneCov<const N: usize>(Lanes);
+/// What a lane instruction does.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Op {
+    Shear,
+    Rotate,
+    Scale,
+    AddVariance,
+    /// A one-axis lobe; the lanes' finiteness is checked before it (as the scalar tape
+    /// does: a lobe may zero a row that held ∞).
+    Lobe1,
+}
 
-/// A lane kernel, its two parameters, and whether a finiteness check goes first.
-type LaneInstr<const N: usize> = (Fn2<LaneCov<N>>, f64, f64, bool);
+/// One kernel of the lane program: what, on which indices (< `N`), with which
+/// parameters.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct LaneOp {
+    op: Op,
+    i: u8,
+    j: u8,
+    x: f64,
+    y: f64,
+}
 
-/// The tape's simple kernels as constant-index lane kernels (`None` if one is not
-/// simple or out of range).
-fn lower_lanes<const N: usize>(tape: &Tape) -> Option<Vec<LaneInstr<N>>> {
+/// The tape's simple kernels as lane instructions (`None` if one has no lane form or an
+/// index is out of range: the states then run one by one).
+fn lower_lanes<const N: usize>(tape: &Tape) -> Option<Vec<LaneOp>> {
     let fits = |i: u8| (i as usize) < N;
+    let op = |op, i, j, x, y| Some(LaneOp { op, i, j, x, y });
     tape.kernels()
         .iter()
         .map(|k| match *k {
-            Kernel::Shear { i, j, s } if fits(i) && fits(j) => {
-                pair_fn!(i, j, LaneCov<N>, |k, a, b, ci, cj| shear::<N>(
-                    &mut k.0, ci, cj, a
-                ))
-                .map(|f| (f, s, 0.0, false))
-            }
-            Kernel::Rotate { i, j, c, s } if fits(i) && fits(j) => {
-                pair_fn!(i, j, LaneCov<N>, |k, a, b, ci, cj| rotate::<N>(
-                    &mut k.0, ci, cj, a, b
-                ))
-                .map(|f| (f, c, s, false))
-            }
-            Kernel::Scale { i, c } if fits(i) => {
-                index_fn!(i, LaneCov<N>, |k, a, b, ci| scale::<N>(&mut k.0, ci, a))
-                    .map(|f| (f, c, 0.0, false))
-            }
-            Kernel::AddVariance { i, w } if fits(i) => index_fn!(i, LaneCov<N>, |k, a, b, ci| {
-                let d = &mut k.0[ix::<N>(ci, ci)];
-                for v in d.iter_mut() {
-                    *v += a;
-                }
-            })
-            .map(|f| (f, w, 0.0, false)),
-            Kernel::Lobe1 { p, s } if fits(p) => {
-                index_fn!(p, LaneCov<N>, |k, a, b, ci| lobe_1::<N>(&mut k.0, ci, a))
-                    .map(|f| (f, s, 0.0, true))
-            }
+            Kernel::Shear { i, j, s } if fits(i) && fits(j) && i != j => op(Op::Shear, i, j, s, 0.0),
+            Kernel::Rotate { i, j, c, s } if fits(i) && fits(j) && i != j => op(Op::Rotate, i, j, c, s),
+            Kernel::Scale { i, c } if fits(i) => op(Op::Scale, i, 0, c, 0.0),
+            Kernel::AddVariance { i, w } if fits(i) => op(Op::AddVariance, i, 0, w, 0.0),
+            Kernel::Lobe1 { p, s } if fits(p) => op(Op::Lobe1, p, 0, s, 0.0),
             _ => None,
         })
         .collect()
+}
+
+/// `$body` with `$ci`, `$cj` bound to the constants equal to the run-time indices
+/// `($i, $j)` (distinct, below 5), so that each arm is the closed-form update of the
+/// few entries it touches.
+macro_rules! const_pair {
+    ($i:expr, $j:expr, |$ci:ident, $cj:ident| $body:expr) => {{
+        macro_rules! arm {
+            ($x:literal, $y:literal) => {{
+                let ($ci, $cj): (usize, usize) = ($x, $y);
+                $body
+            }};
+        }
+        match ($i, $j) {
+            (0, 1) => arm!(0, 1),
+            (0, 2) => arm!(0, 2),
+            (0, 3) => arm!(0, 3),
+            (0, 4) => arm!(0, 4),
+            (1, 0) => arm!(1, 0),
+            (1, 2) => arm!(1, 2),
+            (1, 3) => arm!(1, 3),
+            (1, 4) => arm!(1, 4),
+            (2, 0) => arm!(2, 0),
+            (2, 1) => arm!(2, 1),
+            (2, 3) => arm!(2, 3),
+            (2, 4) => arm!(2, 4),
+            (3, 0) => arm!(3, 0),
+            (3, 1) => arm!(3, 1),
+            (3, 2) => arm!(3, 2),
+            (3, 4) => arm!(3, 4),
+            (4, 0) => arm!(4, 0),
+            (4, 1) => arm!(4, 1),
+            (4, 2) => arm!(4, 2),
+            (4, 3) => arm!(4, 3),
+            _ => {}
+        }
+    }};
+}
+
+/// `$body` with `$ci` bound to the constant equal to the run-time index `$i` (below 5).
+macro_rules! const_index {
+    ($i:expr, |$ci:ident| $body:expr) => {{
+        macro_rules! arm {
+            ($x:literal) => {{
+                let $ci: usize = $x;
+                $body
+            }};
+        }
+        match $i {
+            0 => arm!(0),
+            1 => arm!(1),
+            2 => arm!(2),
+            3 => arm!(3),
+            4 => arm!(4),
+            _ => {}
+        }
+    }};
+}
+
+/// A chunk of states through the lane program, [`LANES`] at a time: each group is
+/// transposed to structure-of-arrays (each entry of Σ a contiguous array over the
+/// group's states), runs the program instruction by instruction (one dispatch per
+/// instruction and group, then a unit-stride loop over the lanes), and is transposed
+/// back; the indices (in `chunk`) of states whose lanes became non-finite are pushed to
+/// `poisoned`, and those states are left as they were.
+///
+/// Compiled once per instruction set and chosen at run time (AVX-512, AVX2, or the
+/// target's baseline): the lane loops are written for the compiler to vectorise, so
+/// the width of the machine's vectors is the width of a step. No fused multiply-add is
+/// enabled, so every lane computes exactly what the scalar kernels compute.
+#[multiversion::multiversion(targets("x86_64+avx512f+avx512dq+avx512vl", "x86_64+avx2"))]
+fn run_chunk<const N: usize>(prog: &[LaneOp], chunk: &mut [Cov<N>], poisoned: &mut Vec<usize>) {
+    let mut a: Box<Lanes> = Box::new([[0.0; LANES]; 15]);
+    for (g, group) in chunk.chunks_mut(LANES).enumerate() {
+        // A ragged tail runs as a partial group (the spare lanes hold copies of its
+        // first state and are discarded), so every state takes the same arithmetic.
+        for l in 0..LANES {
+            let s = group[l.min(group.len() - 1)].raw();
+            for e in 0..Cov::<N>::PACKED_LEN {
+                a[e][l] = s[e];
+            }
+        }
+        let mut bad = [false; LANES];
+        run_group::<N>(prog, &mut a, &mut bad);
+        mark_non_finite::<N>(&a, &mut bad);
+        for (l, s) in group.iter_mut().enumerate() {
+            if bad[l] {
+                poisoned.push(g * LANES + l);
+                continue;
+            }
+            let s = s.raw_mut();
+            for e in 0..Cov::<N>::PACKED_LEN {
+                s[e] = a[e][l];
+            }
+        }
+    }
+}
+
+/// The lane program on one group: each instruction dispatched to its constant-index
+/// kernel, inlined here (and so compiled for the instruction set of [`run_chunk`]).
+#[inline(always)]
+fn run_group<const N: usize>(prog: &[LaneOp], a: &mut Lanes, bad: &mut [bool; LANES]) {
+    for k in prog {
+        let (x, y) = (k.x, k.y);
+        match k.op {
+            Op::Shear => const_pair!(k.i, k.j, |i, j| shear::<N>(a, i, j, x)),
+            Op::Rotate => const_pair!(k.i, k.j, |i, j| rotate::<N>(a, i, j, x, y)),
+            Op::Scale => const_index!(k.i, |i| scale::<N>(a, i, x)),
+            Op::AddVariance => const_index!(k.i, |i| {
+                for v in a[ix::<N>(i, i)].iter_mut() {
+                    *v += x;
+                }
+            }),
+            Op::Lobe1 => {
+                // As the scalar tape: a lobe may hide an ∞, so check before it.
+                mark_non_finite::<N>(a, bad);
+                const_index!(k.i, |i| lobe_1::<N>(a, i, x))
+            }
+        }
+    }
 }
 
 #[inline(always)]
@@ -407,19 +497,28 @@ fn lobe_1<const N: usize>(a: &mut Lanes, p: usize, s: f64) {
     }
     // `Cov::snap_cancelled`: a diagonal that is negative, had no content, or (off the
     // lobe's axis) cancelled to SCHUR_SNAP of its value is noise; its row and column
-    // become 0.
+    // become 0. Entry (x, y) is zeroed if row x or row y is noise (one pass per packed
+    // entry, and none at all for a row no lane snaps: the usual case).
+    let mut noise = [[false; LANES]; 5];
+    let mut any = [false; 5];
     for x in 0..N {
-        let d = a[ix::<N>(x, x)];
-        let mut noise = [false; LANES];
+        let d = &a[ix::<N>(x, x)];
+        let mut hit = false;
         for l in 0..LANES {
-            noise[l] =
-                d[l] < 0.0 || before[x][l] <= 0.0 || (x != p && d[l] <= crate::SCHUR_SNAP * before[x][l]);
+            let n = d[l] < 0.0 || before[x][l] <= 0.0 || (x != p && d[l] <= crate::SCHUR_SNAP * before[x][l]);
+            noise[x][l] = n;
+            hit |= n;
         }
-        for y in 0..N {
-            let e = &mut a[ix::<N>(x, y)];
-            for l in 0..LANES {
-                if noise[l] {
-                    e[l] = 0.0;
+        any[x] = hit;
+    }
+    for x in 0..N {
+        for y in x..N {
+            if any[x] || any[y] {
+                let e = &mut a[ix::<N>(x, y)];
+                for l in 0..LANES {
+                    if noise[x][l] || noise[y][l] {
+                        e[l] = 0.0;
+                    }
                 }
             }
         }

@@ -129,6 +129,19 @@ impl<const N: usize> Cov<N> {
         &self.p[..Self::PACKED_LEN]
     }
 
+    /// The whole packed storage (the first [`Cov::PACKED_LEN`] entries are Σ's), for
+    /// kernels that move many states at once.
+    #[inline(always)]
+    pub(crate) fn raw(&self) -> &[f64; PACKED] {
+        &self.p
+    }
+
+    /// [`Cov::raw`], writable: the caller keeps Σ symmetric PSD (a kernel's result).
+    #[inline(always)]
+    pub(crate) fn raw_mut(&mut self) -> &mut [f64; PACKED] {
+        &mut self.p
+    }
+
     /// Diagonal Σ from per-axis variances of the spectrum ((cycles/unit)²).
     ///
     /// # Errors

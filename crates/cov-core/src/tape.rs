@@ -156,7 +156,7 @@ impl Clone for Tape {
 }
 
 /// A kernel with constant indices, as a plain function of its two parameters.
-pub(crate) type Fn2<K> = fn(&mut K, f64, f64);
+type Fn2<K> = fn(&mut K, f64, f64);
 
 /// One lowered kernel: a constant-index function (of one kernel or a [`pair`]), the same
 /// after a finiteness check (a lobe, which may zero a row that held ∞), a window of
@@ -340,8 +340,6 @@ macro_rules! index_fn {
         }
     }};
 }
-
-pub(crate) use {index_fn, pair_fn};
 
 /// Lowers kernel `q` for the concrete form `K`: indices become constants, so each call
 /// is the closed-form update of the few entries it touches.
