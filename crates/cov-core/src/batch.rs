@@ -9,13 +9,14 @@
 
 use rayon::prelude::*;
 
-use crate::tape::Kernel;
+use crate::form::Kernels;
+use crate::tape::{Code, Direct, Instr, const_index, const_pair};
 use crate::{Chain, Cov, CovError, CovFactor, Form, Spectrum, Tape};
 
 /// States stored side by side in a structure-of-arrays group: each entry of Σ is one
 /// contiguous array over the group's states (at most 30 KB for layout 5, within a
 /// core's first-level cache).
-pub const LANES: usize = 256;
+pub const LANES: usize = 64;
 
 /// States per parallel task.
 pub const CHUNK: usize = 512;
@@ -162,7 +163,9 @@ impl Chain {
 /// (rayon, chunks of [`CHUNK`]): the batch with per-state parameters, what a renderer
 /// calls for a tile of paths whose operators differ from path to path. `ops(i, s)`
 /// applies state `i`'s operators to `s` (built on the stack: nothing is allocated per
-/// state). Each state runs the checked kernels, as one [`Chain::eval_in`] does.
+/// state). Each state runs as a chain's first [`Chain::eval_in`] does: the operators
+/// on the unchecked kernels, then, only if the result is not clean, again on the
+/// checked kernels, which report the failing operator.
 ///
 /// Returns the states that failed with what `ops` reported, or an overflow if `ops`
 /// left Σ non-finite; those states are left as they were.
@@ -171,13 +174,14 @@ impl Chain {
 /// use cov_core::{Axis, Cov, CovError, Form, Spectrum, eval_batch_with};
 /// // Travel by a distance of its own per state.
 /// let distances: Vec<f64> = (0..100).map(|i| 0.1 * i as f64).collect();
-/// let mut states = vec![Cov::<2>::gaussian([0.5, 1.0])?; 100];
+/// let mut states = vec![Cov::<2>::from_diagonal([0.5, 1.0])?; 100];
 /// let failed = eval_batch_with(Form::Covariance, &mut states, |i, s: &mut dyn Spectrum| {
 ///     s.shear(Axis::X, Axis::U, -distances[i])
 /// });
 /// assert!(failed.is_empty());
-/// assert_eq!(states[0].get(0, 0), 0.5);
-/// assert!(states[99].get(0, 0) > 10.0);
+/// // Travel spreads spatial content into the direction axis: Σ_uu = 1 + d² Σ_xx.
+/// assert_eq!(states[0].get(1, 1), 1.0);
+/// assert!((states[99].get(1, 1) - (1.0 + 9.9f64.powi(2) * 0.5)).abs() < 1e-12);
 /// # Ok::<(), CovError>(())
 /// ```
 pub fn eval_batch_with<const N: usize, F>(form: Form, states: &mut [Cov<N>], ops: F) -> Vec<(usize, CovError)>
@@ -194,15 +198,31 @@ where
                 value,
             }),
         };
+        // The fast path first: the operators on the unchecked kernels (`Direct`), one
+        // finiteness check at the end; if anything is not clean, the checked kernels
+        // from the start, which report exactly what failed.
         match form {
             Form::Covariance => {
+                let mut c = *s;
+                if ops(i, &mut Direct(&mut c)).is_ok() && c.all_finite() {
+                    *s = c;
+                    return Ok(());
+                }
                 let mut c = *s;
                 ops(i, &mut c)?;
                 finite(&c)?;
                 *s = c;
             }
             Form::SquareRoot => {
-                let mut f = CovFactor::from_cov(s);
+                let start = CovFactor::from_cov(s);
+                let mut f = start;
+                if ops(i, &mut Direct(&mut f)).is_ok() && f.all_finite() {
+                    if let Ok(c) = f.to_cov() {
+                        *s = c;
+                        return Ok(());
+                    }
+                }
+                let mut f = start;
                 ops(i, &mut f)?;
                 finite(&f)?;
                 *s = f.to_cov()?;
@@ -228,102 +248,32 @@ where
     failed
 }
 
-/// What a lane instruction does.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-enum Op {
-    Shear,
-    Rotate,
-    Scale,
-    AddVariance,
-    /// A one-axis lobe; the lanes' finiteness is checked before it (as the scalar tape
-    /// does: a lobe may zero a row that held ∞).
-    Lobe1,
-}
-
-/// One kernel of the lane program: what, on which indices (< `N`), with which
-/// parameters.
+/// One instruction of the lane program: the compiled program's [`Instr::Op`].
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct LaneOp {
-    op: Op,
+    code: Code,
     i: u8,
     j: u8,
     x: f64,
     y: f64,
 }
 
-/// The tape's simple kernels as lane instructions (`None` if one has no lane form or an
-/// index is out of range: the states then run one by one).
+/// The tape's compiled program as lane instructions (`None` if an instruction has no
+/// lane form, a window or a general kernel: the states then run one by one).
 fn lower_lanes<const N: usize>(tape: &Tape) -> Option<Vec<LaneOp>> {
-    let fits = |i: u8| (i as usize) < N;
-    let op = |op, i, j, x, y| Some(LaneOp { op, i, j, x, y });
-    tape.kernels()
+    tape.program()?
         .iter()
-        .map(|k| match *k {
-            Kernel::Shear { i, j, s } if fits(i) && fits(j) && i != j => op(Op::Shear, i, j, s, 0.0),
-            Kernel::Rotate { i, j, c, s } if fits(i) && fits(j) && i != j => op(Op::Rotate, i, j, c, s),
-            Kernel::Scale { i, c } if fits(i) => op(Op::Scale, i, 0, c, 0.0),
-            Kernel::AddVariance { i, w } if fits(i) => op(Op::AddVariance, i, 0, w, 0.0),
-            Kernel::Lobe1 { p, s } if fits(p) => op(Op::Lobe1, p, 0, s, 0.0),
+        .map(|ins| match *ins {
+            Instr::Op { code, i, j, a, b } => Some(LaneOp {
+                code,
+                i,
+                j,
+                x: a,
+                y: b,
+            }),
             _ => None,
         })
         .collect()
-}
-
-/// `$body` with `$ci`, `$cj` bound to the constants equal to the run-time indices
-/// `($i, $j)` (distinct, below 5), so that each arm is the closed-form update of the
-/// few entries it touches.
-macro_rules! const_pair {
-    ($i:expr, $j:expr, |$ci:ident, $cj:ident| $body:expr) => {{
-        macro_rules! arm {
-            ($x:literal, $y:literal) => {{
-                let ($ci, $cj): (usize, usize) = ($x, $y);
-                $body
-            }};
-        }
-        match ($i, $j) {
-            (0, 1) => arm!(0, 1),
-            (0, 2) => arm!(0, 2),
-            (0, 3) => arm!(0, 3),
-            (0, 4) => arm!(0, 4),
-            (1, 0) => arm!(1, 0),
-            (1, 2) => arm!(1, 2),
-            (1, 3) => arm!(1, 3),
-            (1, 4) => arm!(1, 4),
-            (2, 0) => arm!(2, 0),
-            (2, 1) => arm!(2, 1),
-            (2, 3) => arm!(2, 3),
-            (2, 4) => arm!(2, 4),
-            (3, 0) => arm!(3, 0),
-            (3, 1) => arm!(3, 1),
-            (3, 2) => arm!(3, 2),
-            (3, 4) => arm!(3, 4),
-            (4, 0) => arm!(4, 0),
-            (4, 1) => arm!(4, 1),
-            (4, 2) => arm!(4, 2),
-            (4, 3) => arm!(4, 3),
-            _ => {}
-        }
-    }};
-}
-
-/// `$body` with `$ci` bound to the constant equal to the run-time index `$i` (below 5).
-macro_rules! const_index {
-    ($i:expr, |$ci:ident| $body:expr) => {{
-        macro_rules! arm {
-            ($x:literal) => {{
-                let $ci: usize = $x;
-                $body
-            }};
-        }
-        match $i {
-            0 => arm!(0),
-            1 => arm!(1),
-            2 => arm!(2),
-            3 => arm!(3),
-            4 => arm!(4),
-            _ => {}
-        }
-    }};
 }
 
 /// A chunk of states through the lane program, [`LANES`] at a time: each group is
@@ -371,21 +321,45 @@ fn run_chunk<const N: usize>(prog: &[LaneOp], chunk: &mut [Cov<N>], poisoned: &m
 fn run_group<const N: usize>(prog: &[LaneOp], a: &mut Lanes, bad: &mut [bool; LANES]) {
     for k in prog {
         let (x, y) = (k.x, k.y);
-        match k.op {
-            Op::Shear => const_pair!(k.i, k.j, |i, j| shear::<N>(a, i, j, x)),
-            Op::Rotate => const_pair!(k.i, k.j, |i, j| rotate::<N>(a, i, j, x, y)),
-            Op::Scale => const_index!(k.i, |i| scale::<N>(a, i, x)),
-            Op::AddVariance => const_index!(k.i, |i| {
-                for v in a[ix::<N>(i, i)].iter_mut() {
-                    *v += x;
-                }
-            }),
-            Op::Lobe1 => {
+        match k.code {
+            Code::Shear => const_pair!(k.i, k.j, |i, j| shear::<N>(a, i, j, x)),
+            Code::Rotate => const_pair!(k.i, k.j, |i, j| rotate::<N>(a, i, j, x, y)),
+            Code::Scale => const_index!(k.i, |i| scale::<N>(a, i, x)),
+            Code::AddVariance => const_index!(k.i, |i| add_variance::<N>(a, i, x)),
+            Code::Lobe1 => {
                 // As the scalar tape: a lobe may hide an ∞, so check before it.
                 mark_non_finite::<N>(a, bad);
                 const_index!(k.i, |i| lobe_1::<N>(a, i, x))
             }
+            Code::ShearXU => {
+                shear::<N>(a, 0, 2, x);
+                shear::<N>(a, 1, 3, y);
+            }
+            Code::ShearUX => {
+                shear::<N>(a, 2, 0, x);
+                shear::<N>(a, 3, 1, y);
+            }
+            Code::RotateFrame => {
+                rotate::<N>(a, 0, 1, x, y);
+                rotate::<N>(a, 2, 3, x, y);
+            }
+            Code::ScaleUV => {
+                scale::<N>(a, 2, x);
+                scale::<N>(a, 3, y);
+            }
+            Code::VarianceXY => {
+                add_variance::<N>(a, 0, x);
+                add_variance::<N>(a, 1, y);
+            }
         }
+    }
+}
+
+/// `Σ_ii += w`, lane by lane.
+#[inline(always)]
+fn add_variance<const N: usize>(a: &mut Lanes, i: usize, w: f64) {
+    for v in a[ix::<N>(i, i)].iter_mut() {
+        *v += w;
     }
 }
 

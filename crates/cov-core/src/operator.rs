@@ -5,6 +5,7 @@ use std::sync::atomic::{AtomicU32, Ordering};
 use std::sync::{Arc, OnceLock};
 
 use crate::form::Kernels;
+use crate::tape::Direct;
 use crate::{
     AnyCov, AnySpectrum, AxisSet, Concrete, Cov, CovError, Form, Report, Spectrum, Tape, layout_set,
 };
@@ -219,18 +220,28 @@ impl Chain {
         }))
     }
 
-    /// The fast path on a concrete form: the compiled tape on a copy of Σ, committed if
-    /// it ran clean; otherwise (or on a first evaluation) the checked path, which finds
-    /// and reports the failing step and leaves Σ as it was.
+    /// The fast path on a concrete form, on a copy of Σ committed if it ran clean: the
+    /// compiled tape, or on a first evaluation the operators applied to the unchecked
+    /// kernels ([`Direct`]). Otherwise the checked path, which finds and reports the
+    /// failing step and leaves Σ as it was.
     fn apply_fast<K: Kernels>(&self, k: &mut K) -> Result<(), CovError> {
-        if let Some(tape) = self.tape::<K>(false) {
-            let mut work = *k;
-            if tape.run(&mut work) {
-                *k = work;
-                return Ok(());
-            }
+        let mut work = *k;
+        let clean = match self.tape::<K>(false) {
+            Some(tape) => tape.run(&mut work),
+            None => self.apply_direct(&mut work),
+        };
+        if clean {
+            *k = work;
+            return Ok(());
         }
         self.apply_checked(k)
+    }
+
+    /// Every step on the unchecked kernels; whether all ran and Σ is finite (`k` is
+    /// garbage otherwise).
+    pub(crate) fn apply_direct<K: Kernels>(&self, k: &mut K) -> bool {
+        let mut d = Direct(k);
+        self.steps.iter().all(|op| op.apply(&mut d).is_ok()) && d.0.all_finite()
     }
 
     /// Every step with its checks: parameters, axes, the kernels' overflow checks and a

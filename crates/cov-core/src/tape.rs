@@ -139,7 +139,7 @@ pub struct Tape {
     dim: usize,
     form: Form,
     kernels: Vec<Kernel>,
-    /// The kernels lowered for the concrete form (`Vec<Instr<K>>`), built by
+    /// The kernels lowered for the concrete form (`Vec<Instr>`), built by
     /// [`Tape::prepare`] for tapes that run many times (a [`crate::Chain`]'s).
     program: OnceLock<Box<dyn Any + Send + Sync>>,
 }
@@ -155,21 +155,52 @@ impl Clone for Tape {
     }
 }
 
-/// A kernel with constant indices, as a plain function of its two parameters.
-type Fn2<K> = fn(&mut K, f64, f64);
+/// What a lowered kernel does: one kernel with indices (turned into constants when it
+/// runs), or a pair of kernels that one operator makes on the transverse planes (x, u)
+/// and (y, v) of layouts 4 and 5 ([`pair`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum Code {
+    Shear,
+    Rotate,
+    Scale,
+    AddVariance,
+    /// After a finiteness check (a lobe may zero a row that held ∞).
+    Lobe1,
+    /// Shears (0, 2) and (1, 3): travel.
+    ShearXU,
+    /// Shears (2, 0) and (3, 1): curvature.
+    ShearUX,
+    /// Rotations of (0, 1) and (2, 3) by the same angle: a frame rotation.
+    RotateFrame,
+    /// Scales of 2 and 3: a mirror.
+    ScaleUV,
+    /// Variances on 0 and 1 (covariance form): a window.
+    VarianceXY,
+}
 
-/// One lowered kernel: a constant-index function (of one kernel or a [`pair`]), the same
-/// after a finiteness check (a lobe, which may zero a row that held ∞), a window of
+/// One lowered kernel: a [`Code`] with its indices and two parameters, a window of
 /// several variances (square-root form), or the general kernel `q` of the tape.
-enum Instr<K> {
-    Plain(Fn2<K>, f64, f64),
-    Checked(Fn2<K>, f64, f64),
+#[derive(Debug)]
+pub(crate) enum Instr {
+    /// A simple kernel or a transverse pair (indices below the layout size).
+    Op {
+        /// What it does.
+        code: Code,
+        /// First index (unused by pairs).
+        i: u8,
+        /// Second index (shears and rotations).
+        j: u8,
+        /// First parameter.
+        a: f64,
+        /// Second parameter.
+        b: f64,
+    },
     Window(Box<Block>),
     General(usize),
 }
 
 /// The tape's kernels lowered for the concrete form `K` as its compiled program: pairs of kernels that one
-/// operator makes on the two transverse planes ([`pair`]) become one call; in
+/// operator makes on the two transverse planes ([`pair`]) become one instruction; in
 /// square-root form, a run of variances added on distinct axes becomes one window (each
 /// `AddVariance` folds the factor back with Householder reflections, the form's most
 /// expensive kernel; one fold of `k` new columns does the work of `k`, to rounding).
@@ -178,7 +209,7 @@ enum Instr<K> {
 /// covariance bounce chain by a quarter, but the stiff suite's 10⁴-operator chain lost a
 /// factor 3 in accuracy in covariance form (4.1e-9 → 1.3e-8, past its 1e-8 limit): a
 /// composed `G` rounds entries the kernels keep exact.
-fn plan<K: Kernels>(kernels: &[Kernel]) -> Vec<Instr<K>> {
+fn plan<K: Kernels>(kernels: &[Kernel]) -> Vec<Instr> {
     let n = K::DIM;
     let mut out = Vec::with_capacity(kernels.len());
     let mut q = 0;
@@ -213,31 +244,25 @@ fn plan<K: Kernels>(kernels: &[Kernel]) -> Vec<Instr<K>> {
 }
 
 /// Two consecutive kernels that one operator makes on the transverse planes (x, u) and
-/// (y, v) of layouts 4 and 5, as one constant-index function of their two parameters:
-/// travel's and curvature's two shears, a frame rotation's two planes, two scales of
-/// u and v (a mirror), two variances on x and y (a window). `None` for anything else.
-fn pair<K: Kernels>(a: &Kernel, b: &Kernel) -> Option<Instr<K>> {
+/// (y, v) of layouts 4 and 5, as one instruction: travel's and curvature's two shears, a
+/// frame rotation's two planes, two scales of u and v (a mirror), two variances on x and
+/// y (a window, covariance form). `None` for anything else.
+fn pair<K: Kernels>(a: &Kernel, b: &Kernel) -> Option<Instr> {
     if K::DIM < 4 {
         return None;
     }
-    let plain = |f: Fn2<K>, x: f64, y: f64| Some(Instr::Plain(f, x, y));
+    let op = |code, a, b| {
+        Some(Instr::Op {
+            code,
+            i: 0,
+            j: 0,
+            a,
+            b,
+        })
+    };
     match (a, b) {
-        (&Kernel::Shear { i: 0, j: 2, s }, &Kernel::Shear { i: 1, j: 3, s: t }) => plain(
-            |k, s, t| {
-                k.k_shear(0, 2, s);
-                k.k_shear(1, 3, t);
-            },
-            s,
-            t,
-        ),
-        (&Kernel::Shear { i: 2, j: 0, s }, &Kernel::Shear { i: 3, j: 1, s: t }) => plain(
-            |k, s, t| {
-                k.k_shear(2, 0, s);
-                k.k_shear(3, 1, t);
-            },
-            s,
-            t,
-        ),
+        (&Kernel::Shear { i: 0, j: 2, s }, &Kernel::Shear { i: 1, j: 3, s: t }) => op(Code::ShearXU, s, t),
+        (&Kernel::Shear { i: 2, j: 0, s }, &Kernel::Shear { i: 3, j: 1, s: t }) => op(Code::ShearUX, s, t),
         (
             &Kernel::Rotate { i: 0, j: 1, c, s },
             &Kernel::Rotate {
@@ -246,122 +271,88 @@ fn pair<K: Kernels>(a: &Kernel, b: &Kernel) -> Option<Instr<K>> {
                 c: c2,
                 s: s2,
             },
-        ) if c.to_bits() == c2.to_bits() && s.to_bits() == s2.to_bits() => plain(
-            |k, c, s| {
-                k.k_rotate(0, 1, c, s);
-                k.k_rotate(2, 3, c, s);
-            },
-            c,
-            s,
-        ),
-        (&Kernel::Scale { i: 2, c }, &Kernel::Scale { i: 3, c: d }) => plain(
-            |k, c, d| {
-                k.k_scale(2, c);
-                k.k_scale(3, d);
-            },
-            c,
-            d,
-        ),
+        ) if c.to_bits() == c2.to_bits() && s.to_bits() == s2.to_bits() => op(Code::RotateFrame, c, s),
+        (&Kernel::Scale { i: 2, c }, &Kernel::Scale { i: 3, c: d }) => op(Code::ScaleUV, c, d),
         (&Kernel::AddVariance { i: 0, w }, &Kernel::AddVariance { i: 1, w: v })
             if K::FORM == Form::Covariance =>
         {
-            plain(
-                |k, w, v| {
-                    k.k_add_variance(0, w);
-                    k.k_add_variance(1, v);
-                },
-                w,
-                v,
-            )
+            op(Code::VarianceXY, w, v)
         }
         _ => None,
     }
 }
 
-/// Every (i, j) pair of distinct indices below 5, for the constant-index functions.
-macro_rules! pair_fn {
-    ($i:expr, $j:expr, $k:ty, |$kk:ident, $a:ident, $b:ident, $ci:ident, $cj:ident| $body:expr) => {{
-        macro_rules! one {
+/// `$body` with `$ci`, `$cj` bound to the constants equal to the run-time indices
+/// `($i, $j)` (distinct, below 5), so that each arm is the closed-form update of the
+/// few entries it touches.
+macro_rules! const_pair {
+    ($i:expr, $j:expr, |$ci:ident, $cj:ident| $body:expr) => {{
+        macro_rules! arm {
             ($x:literal, $y:literal) => {{
-                let f: Fn2<$k> = |$kk: &mut $k, $a: f64, $b: f64| {
-                    let ($ci, $cj) = ($x, $y);
-                    let _ = ($a, $b, $ci, $cj);
-                    $body
-                };
-                Some(f)
+                let ($ci, $cj): (usize, usize) = ($x, $y);
+                $body
             }};
         }
         match ($i, $j) {
-            (0, 1) => one!(0, 1),
-            (0, 2) => one!(0, 2),
-            (0, 3) => one!(0, 3),
-            (0, 4) => one!(0, 4),
-            (1, 0) => one!(1, 0),
-            (1, 2) => one!(1, 2),
-            (1, 3) => one!(1, 3),
-            (1, 4) => one!(1, 4),
-            (2, 0) => one!(2, 0),
-            (2, 1) => one!(2, 1),
-            (2, 3) => one!(2, 3),
-            (2, 4) => one!(2, 4),
-            (3, 0) => one!(3, 0),
-            (3, 1) => one!(3, 1),
-            (3, 2) => one!(3, 2),
-            (3, 4) => one!(3, 4),
-            (4, 0) => one!(4, 0),
-            (4, 1) => one!(4, 1),
-            (4, 2) => one!(4, 2),
-            (4, 3) => one!(4, 3),
-            _ => None,
+            (0, 1) => arm!(0, 1),
+            (0, 2) => arm!(0, 2),
+            (0, 3) => arm!(0, 3),
+            (0, 4) => arm!(0, 4),
+            (1, 0) => arm!(1, 0),
+            (1, 2) => arm!(1, 2),
+            (1, 3) => arm!(1, 3),
+            (1, 4) => arm!(1, 4),
+            (2, 0) => arm!(2, 0),
+            (2, 1) => arm!(2, 1),
+            (2, 3) => arm!(2, 3),
+            (2, 4) => arm!(2, 4),
+            (3, 0) => arm!(3, 0),
+            (3, 1) => arm!(3, 1),
+            (3, 2) => arm!(3, 2),
+            (3, 4) => arm!(3, 4),
+            (4, 0) => arm!(4, 0),
+            (4, 1) => arm!(4, 1),
+            (4, 2) => arm!(4, 2),
+            (4, 3) => arm!(4, 3),
+            _ => {}
         }
     }};
 }
 
-/// Every index below 5, for the constant-index functions.
-macro_rules! index_fn {
-    ($i:expr, $k:ty, |$kk:ident, $a:ident, $b:ident, $ci:ident| $body:expr) => {{
-        macro_rules! one {
+/// `$body` with `$ci` bound to the constant equal to the run-time index `$i` (below 5).
+macro_rules! const_index {
+    ($i:expr, |$ci:ident| $body:expr) => {{
+        macro_rules! arm {
             ($x:literal) => {{
-                let f: Fn2<$k> = |$kk: &mut $k, $a: f64, $b: f64| {
-                    let $ci = $x;
-                    let _ = ($a, $b);
-                    $body
-                };
-                Some(f)
+                let $ci: usize = $x;
+                $body
             }};
         }
         match $i {
-            0 => one!(0),
-            1 => one!(1),
-            2 => one!(2),
-            3 => one!(3),
-            4 => one!(4),
-            _ => None,
+            0 => arm!(0),
+            1 => arm!(1),
+            2 => arm!(2),
+            3 => arm!(3),
+            4 => arm!(4),
+            _ => {}
         }
     }};
 }
 
-/// Lowers kernel `q` for the concrete form `K`: indices become constants, so each call
-/// is the closed-form update of the few entries it touches.
-fn lower<K: Kernels>(kernel: &Kernel, q: usize) -> Instr<K> {
-    let n = K::DIM;
-    let fits = |i: u8| (i as usize) < n;
-    let plain = |f: Option<Fn2<K>>, a, b| f.map_or(Instr::General(q), |f| Instr::Plain(f, a, b));
+pub(crate) use {const_index, const_pair};
+
+/// Lowers kernel `q` for the concrete form `K`: a simple kernel with indices in range
+/// becomes an [`Instr::Op`] (its indices constants when it runs); anything else runs
+/// as the tape's general kernel.
+fn lower<K: Kernels>(kernel: &Kernel, q: usize) -> Instr {
+    let fits = |i: u8| (i as usize) < K::DIM;
+    let op = |code, i, j, a, b| Instr::Op { code, i, j, a, b };
     match *kernel {
-        Kernel::Shear { i, j, s } if fits(i) && fits(j) => {
-            plain(pair_fn!(i, j, K, |k, a, b, ci, cj| k.k_shear(ci, cj, a)), s, 0.0)
-        }
-        Kernel::Rotate { i, j, c, s } if fits(i) && fits(j) => plain(
-            pair_fn!(i, j, K, |k, a, b, ci, cj| k.k_rotate(ci, cj, a, b)),
-            c,
-            s,
-        ),
-        Kernel::Scale { i, c } if fits(i) => plain(index_fn!(i, K, |k, a, b, ci| k.k_scale(ci, a)), c, 0.0),
-        Kernel::AddVariance { i, w } if fits(i) => {
-            plain(index_fn!(i, K, |k, a, b, ci| k.k_add_variance(ci, a)), w, 0.0)
-        }
-        Kernel::Lobe1 { p, s } if fits(p) => index_fn!(p, K, |k, a, b, ci| k.k_lobe_1(ci, a))
-            .map_or(Instr::General(q), |f| Instr::Checked(f, s, 0.0)),
+        Kernel::Shear { i, j, s } if fits(i) && fits(j) && i != j => op(Code::Shear, i, j, s, 0.0),
+        Kernel::Rotate { i, j, c, s } if fits(i) && fits(j) && i != j => op(Code::Rotate, i, j, c, s),
+        Kernel::Scale { i, c } if fits(i) => op(Code::Scale, i, 0, c, 0.0),
+        Kernel::AddVariance { i, w } if fits(i) => op(Code::AddVariance, i, 0, w, 0.0),
+        Kernel::Lobe1 { p, s } if fits(p) => op(Code::Lobe1, p, 0, s, 0.0),
         _ => Instr::General(q),
     }
 }
@@ -471,50 +462,121 @@ impl Tape {
     /// square-root form a run of variances as one window.
     pub(crate) fn prepare<K: Kernels>(&self) {
         self.program.get_or_init(|| {
-            let prog: Vec<Instr<K>> = plan::<K>(&self.kernels);
+            let prog: Vec<Instr> = plan::<K>(&self.kernels);
             Box::new(prog)
         });
     }
 
+    /// The compiled program, once [`Tape::prepare`] has built it.
+    pub(crate) fn program(&self) -> Option<&[Instr]> {
+        self.program
+            .get()
+            .and_then(|p| p.downcast_ref::<Vec<Instr>>())
+            .map(|p| p.as_slice())
+    }
+
     /// Runs every kernel on `k` in place; false if the layout or form does not match,
     /// an opaque step failed or the result is not finite (`k` is then garbage).
+    ///
+    /// A prepared tape runs its program on a local copy of Σ, every simple kernel
+    /// dispatched to its constant-index form inlined here, so that the compiler may keep
+    /// Σ's entries in registers from one kernel to the next; the few kernels that are
+    /// not inlined (windows in square-root form, general and opaque steps) take a copy.
     #[inline]
     pub(crate) fn run<K: Kernels>(&self, k: &mut K) -> bool {
         if K::DIM != self.dim || K::FORM != self.form {
             return false;
         }
-        let prog = self.program.get().and_then(|p| p.downcast_ref::<Vec<Instr<K>>>());
-        if let Some(prog) = prog {
-            for ins in prog {
-                match *ins {
-                    Instr::Plain(f, a, b) => f(k, a, b),
-                    Instr::Checked(f, a, b) => {
-                        if !k.all_finite() {
-                            return false;
-                        }
-                        f(k, a, b)
-                    }
-                    Instr::Window(ref b) => {
-                        if !k.all_finite() {
-                            return false;
-                        }
-                        k.k_add_window(&b.p[..b.k], &b.m);
-                    }
-                    Instr::General(q) => {
-                        if !self.run_kernel(k, &self.kernels[q]) {
-                            return false;
-                        }
-                    }
-                }
-            }
-        } else {
+        let Some(prog) = self.program() else {
             for kernel in &self.kernels {
                 if !self.run_kernel(k, kernel) {
                     return false;
                 }
             }
+            return k.all_finite();
+        };
+        if K::FORM == Form::Covariance {
+            // Σ's entries may live in registers: a local copy, written back on success.
+            let mut w = *k;
+            if !self.exec(prog, &mut w) {
+                return false;
+            }
+            *k = w;
+            true
+        } else {
+            // The factor's lobe and fold are calls: it stays in place.
+            self.exec(prog, k)
         }
-        k.all_finite()
+    }
+
+    /// The program's loop, for [`Tape::run`].
+    #[inline(always)]
+    fn exec<K: Kernels>(&self, prog: &[Instr], w: &mut K) -> bool {
+        // Non-inlined kernels take a copy in covariance form, so that `w` itself is
+        // only ever touched at constant offsets (and may stay in registers).
+        let local = K::FORM == Form::Covariance;
+        for ins in prog {
+            match *ins {
+                Instr::Op { code, i, j, a, b } => match code {
+                    Code::Shear => const_pair!(i, j, |ci, cj| w.k_shear(ci, cj, a)),
+                    Code::Rotate => const_pair!(i, j, |ci, cj| w.k_rotate(ci, cj, a, b)),
+                    Code::Scale => const_index!(i, |ci| w.k_scale(ci, a)),
+                    Code::AddVariance => const_index!(i, |ci| w.k_add_variance(ci, a)),
+                    Code::Lobe1 => {
+                        if !w.all_finite() {
+                            return false;
+                        }
+                        const_index!(i, |ci| w.k_lobe_1(ci, a))
+                    }
+                    Code::ShearXU => {
+                        w.k_shear(0, 2, a);
+                        w.k_shear(1, 3, b);
+                    }
+                    Code::ShearUX => {
+                        w.k_shear(2, 0, a);
+                        w.k_shear(3, 1, b);
+                    }
+                    Code::RotateFrame => {
+                        w.k_rotate(0, 1, a, b);
+                        w.k_rotate(2, 3, a, b);
+                    }
+                    Code::ScaleUV => {
+                        w.k_scale(2, a);
+                        w.k_scale(3, b);
+                    }
+                    Code::VarianceXY => {
+                        w.k_add_variance(0, a);
+                        w.k_add_variance(1, b);
+                    }
+                },
+                Instr::Window(ref b) => {
+                    if !w.all_finite() {
+                        return false;
+                    }
+                    if local {
+                        let mut t = *w;
+                        t.k_add_window(&b.p[..b.k], &b.m);
+                        *w = t;
+                    } else {
+                        w.k_add_window(&b.p[..b.k], &b.m);
+                    }
+                }
+                Instr::General(q) => {
+                    let ok = if local {
+                        let mut t = *w;
+                        let ok = self.run_kernel(&mut t, &self.kernels[q]);
+                        *w = t;
+                        ok
+                    } else {
+                        self.run_kernel(w, &self.kernels[q])
+                    };
+                    if !ok {
+                        return false;
+                    }
+                }
+            }
+        }
+        w.all_finite()
     }
 
     /// One kernel with run-time indices; false if a check before it or an opaque step
@@ -670,4 +732,107 @@ pub(crate) fn concrete_factor<const N: usize>(f: &mut CovFactor<N>) -> crate::Co
         _ => any.downcast_mut::<CovFactor<5>>().map(C::Factor5),
     };
     found.unwrap_or(C::Other)
+}
+
+/// A [`Spectrum`] that runs the unchecked kernels of a concrete form directly: the
+/// one-shot fast path of [`crate::Chain`] (a chain's first evaluation in a layout and
+/// form, and each state of [`crate::eval_batch_with`]). Operators validate their
+/// parameters and resolve their axes as usual; the kernels then run without a check or
+/// a commit per call, and finiteness is checked where a kernel could hide an ∞ (before
+/// a lobe or a window) and, by the caller, at the end. Any error here only means "not
+/// clean": the caller re-runs the operators in checked mode from the start, which
+/// reports the failing step exactly.
+#[derive(Debug)]
+pub(crate) struct Direct<'a, K>(pub(crate) &'a mut K);
+
+impl<K: Kernels> Direct<'_, K> {
+    /// `Err` (never shown: the checked re-run reports) if Σ holds a non-finite entry.
+    #[inline(always)]
+    fn finite(&self, op: &str) -> Result<(), CovError> {
+        if self.0.all_finite() {
+            Ok(())
+        } else {
+            Err(CovError::Overflow {
+                operator: op.into(),
+                row: 0,
+                col: 0,
+                value: f64::NAN,
+            })
+        }
+    }
+}
+
+impl<K: Kernels> Spectrum for Direct<'_, K> {
+    fn dim(&self) -> usize {
+        K::DIM
+    }
+    fn form(&self) -> Form {
+        K::FORM
+    }
+    fn cov(&self) -> Result<AnyCov, CovError> {
+        self.0.cov()
+    }
+    fn assign(&mut self, c: &AnyCov) -> Result<(), CovError> {
+        self.0.assign(c)
+    }
+    fn snapshot(&self) -> AnySpectrum {
+        self.0.snapshot()
+    }
+    fn restore(&mut self, s: &AnySpectrum) {
+        self.0.restore(s)
+    }
+    fn first_non_finite(&self) -> Option<(usize, usize, f64)> {
+        self.0.first_non_finite()
+    }
+    fn concrete(&mut self) -> crate::Concrete<'_> {
+        self.0.concrete()
+    }
+
+    fn raw_congruence(&mut self, _op: &str, a: &Small) -> Result<(), CovError> {
+        self.0.k_congruence(a);
+        Ok(())
+    }
+    #[inline]
+    fn raw_shear(&mut self, _op: &str, i: usize, j: usize, s: f64) -> Result<(), CovError> {
+        self.0.k_shear(i, j, s);
+        Ok(())
+    }
+    #[inline]
+    fn raw_scale(&mut self, _op: &str, i: usize, c: f64) -> Result<(), CovError> {
+        self.0.k_scale(i, c);
+        Ok(())
+    }
+    #[inline]
+    fn raw_rotate(&mut self, _op: &str, planes: &[(usize, usize)], c: f64, s: f64) -> Result<(), CovError> {
+        for &(i, j) in planes {
+            self.0.k_rotate(i, j, c, s);
+        }
+        Ok(())
+    }
+    fn raw_add_window(&mut self, op: &str, p: &[usize], w: &Small) -> Result<(), CovError> {
+        self.finite(op)?;
+        self.0.k_add_window(p, w);
+        Ok(())
+    }
+    #[inline]
+    fn raw_add_variance(&mut self, op: &str, i: usize, w: f64) -> Result<(), CovError> {
+        // The square-root form folds with reflections, which would spread an ∞ as NaN:
+        // the end check still sees it, but check first to keep the fold finite.
+        if K::FORM == Form::SquareRoot {
+            self.finite(op)?;
+        }
+        self.0.k_add_variance(i, w);
+        Ok(())
+    }
+    #[inline]
+    fn raw_lobe_1(&mut self, op: &str, p: usize, s: f64) -> Result<(), CovError> {
+        self.finite(op)?;
+        self.0.k_lobe_1(p, s);
+        Ok(())
+    }
+    fn raw_lobe(&mut self, op: &str, p: &[usize], s: &Small) -> Result<(), CovError> {
+        self.finite(op)?;
+        self.0.k_lobe(p, s);
+        Ok(())
+    }
 }
