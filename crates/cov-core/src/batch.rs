@@ -216,11 +216,12 @@ where
             Form::SquareRoot => {
                 let start = CovFactor::from_cov(s);
                 let mut f = start;
-                if ops(i, &mut Direct(&mut f)).is_ok() && f.all_finite() {
-                    if let Ok(c) = f.to_cov() {
-                        *s = c;
-                        return Ok(());
-                    }
+                if ops(i, &mut Direct(&mut f)).is_ok()
+                    && f.all_finite()
+                    && let Ok(c) = f.to_cov()
+                {
+                    *s = c;
+                    return Ok(());
                 }
                 let mut f = start;
                 ops(i, &mut f)?;
