@@ -364,42 +364,49 @@ fn add_variance<const N: usize>(a: &mut Lanes, i: usize, w: f64) {
     }
 }
 
+/// Marks the lanes holding a non-finite entry: `x − x` is `+0` for a finite `x` and NaN
+/// for ±∞ or NaN, so the lane's sum of them is NaN exactly when one entry is not
+/// finite (two vector operations per entry, no mask conversion per entry).
 #[inline(always)]
 fn mark_non_finite<const N: usize>(a: &Lanes, poisoned: &mut [bool; LANES]) {
+    let mut acc = [0.0f64; LANES];
     for e in a.iter().take(N * (N + 1) / 2) {
         for l in 0..LANES {
-            poisoned[l] |= !e[l].is_finite();
+            acc[l] += e[l] - e[l];
         }
     }
+    for l in 0..LANES {
+        poisoned[l] |= acc[l] != 0.0;
+    }
 }
+
+// The lane kernels: each is the scalar kernel's arithmetic (same operations, same
+// order) in one loop over the lanes, with per-lane locals and no row copies, so that
+// the compiler turns the loop body into vector operations across lanes.
 
 /// `Cov::shear_col` then commit, lane by lane.
 #[inline(always)]
 fn shear<const N: usize>(a: &mut Lanes, i: usize, j: usize, s: f64) {
     let (ii, ij, jj) = (ix::<N>(i, i), ix::<N>(i, j), ix::<N>(j, j));
-    let mut diag = [0.0; LANES];
     for l in 0..LANES {
-        diag[l] = (a[jj][l] + s * (2.0 * a[ij][l] + s * a[ii][l])).abs();
-    }
-    for k in 0..N {
-        if k != j {
-            let (kj, ki) = (ix::<N>(k, j), ix::<N>(k, i));
-            for l in 0..LANES {
+        let diag = (a[jj][l] + s * (2.0 * a[ij][l] + s * a[ii][l])).abs();
+        for k in 0..N {
+            if k != j {
+                let (kj, ki) = (ix::<N>(k, j), ix::<N>(k, i));
                 a[kj][l] += s * a[ki][l];
             }
         }
+        a[jj][l] = diag;
     }
-    a[jj] = diag;
 }
 
 /// `Cov::scale_col` then commit, lane by lane.
 #[inline(always)]
 fn scale<const N: usize>(a: &mut Lanes, i: usize, c: f64) {
-    for k in 0..N {
-        let f = if k == i { c * c } else { c };
-        let e = &mut a[ix::<N>(k, i)];
-        for v in e.iter_mut() {
-            *v *= f;
+    for l in 0..LANES {
+        for k in 0..N {
+            let f = if k == i { c * c } else { c };
+            a[ix::<N>(k, i)][l] *= f;
         }
     }
 }
@@ -408,22 +415,20 @@ fn scale<const N: usize>(a: &mut Lanes, i: usize, c: f64) {
 #[inline(always)]
 fn rotate<const N: usize>(a: &mut Lanes, i: usize, j: usize, c: f64, s: f64) {
     let (ii, ij, jj) = (ix::<N>(i, i), ix::<N>(i, j), ix::<N>(j, j));
-    let (sii, sij, sjj) = (a[ii], a[ij], a[jj]);
-    for k in 0..N {
-        if k != i && k != j {
-            let (ki, kj) = (ix::<N>(k, i), ix::<N>(k, j));
-            for l in 0..LANES {
+    let cs = c * s;
+    for l in 0..LANES {
+        let (sii, sij, sjj) = (a[ii][l], a[ij][l], a[jj][l]);
+        for k in 0..N {
+            if k != i && k != j {
+                let (ki, kj) = (ix::<N>(k, i), ix::<N>(k, j));
                 let (x, y) = (a[ki][l], a[kj][l]);
                 a[ki][l] = c * x + s * y;
                 a[kj][l] = c * y - s * x;
             }
         }
-    }
-    let cs = c * s;
-    for l in 0..LANES {
-        a[ii][l] = (c * c * sii[l] + 2.0 * cs * sij[l] + s * s * sjj[l]).abs();
-        a[jj][l] = (s * s * sii[l] - 2.0 * cs * sij[l] + c * c * sjj[l]).abs();
-        a[ij][l] = cs * (sjj[l] - sii[l]) + (c * c - s * s) * sij[l];
+        a[ii][l] = (c * c * sii + 2.0 * cs * sij + s * s * sjj).abs();
+        a[jj][l] = (s * s * sii - 2.0 * cs * sij + c * c * sjj).abs();
+        a[ij][l] = cs * (sjj - sii) + (c * c - s * s) * sij;
     }
 }
 
