@@ -368,6 +368,7 @@ fn add_variance<const N: usize>(a: &mut Lanes, i: usize, w: f64) {
 /// for ±∞ or NaN, so the lane's sum of them is NaN exactly when one entry is not
 /// finite (two vector operations per entry, no mask conversion per entry).
 #[inline(always)]
+#[allow(clippy::eq_op)] // `x − x` is the test itself: NaN exactly for a non-finite `x`.
 fn mark_non_finite<const N: usize>(a: &Lanes, poisoned: &mut [bool; LANES]) {
     let mut acc = [0.0f64; LANES];
     for e in a.iter().take(N * (N + 1) / 2) {
