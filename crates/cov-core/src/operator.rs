@@ -386,10 +386,11 @@ fn apply_step(index: usize, op: &dyn Operator, c: &mut dyn Spectrum) -> Result<(
 }
 
 impl Operator for Chain {
-    /// On `Cov<N>` and `CovFactor<N>` this runs the compiled tape ([`Chain::compile`])
-    /// and falls back to the checked steps only if the tape's result is not finite, so
-    /// errors name the same step, operator and value as the checked path; Σ is left as
-    /// it was on error. Other spectra take the checked path.
+    /// On `Cov<N>` and `CovFactor<N>` this runs the compiled tape ([`Chain::compile`]),
+    /// or on the chain's first evaluation in that layout and form its operators on the
+    /// unchecked kernels, and falls back to the checked steps only if that result is not
+    /// clean, so errors name the same step, operator and value as the checked path; Σ is
+    /// left as it was on error. Other spectra take the checked path.
     fn apply(&self, cov: &mut dyn Spectrum) -> Result<(), CovError> {
         match cov.concrete() {
             Concrete::Cov2(c) => self.apply_fast(c),

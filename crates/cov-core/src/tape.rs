@@ -7,14 +7,20 @@
 //! is repeated in checked mode by the caller, which finds and reports the failing step
 //! exactly as before.
 //!
-//! A chain runs its tape as a program lowered once for the concrete form: each kernel a
-//! function with constant indices; the two kernels an operator makes on the transverse
-//! planes (x, u) and (y, v) (travel, curvature, a frame rotation, a mirror, a window) one
-//! call, with the same operations in the same order; and in square-root form the
-//! variances a window adds on several axes one fold instead of one per axis (the same Σ
-//! to rounding, within the stiff suite's and the random-chain test's bounds). A tape run
-//! through [`Tape::run_cov`] or [`Tape::run_factor`] goes kernel by kernel and gives the
-//! checked kernels' bits.
+//! A chain runs its tape as a program lowered once for the concrete form and run by one
+//! interpreter: each simple kernel, and the two kernels an operator makes on the
+//! transverse planes (x, u) and (y, v) (travel, curvature, a frame rotation, a mirror,
+//! a window) as one instruction, is dispatched to its update with constant indices,
+//! inlined, with the same operations in the same order; in square-root form the
+//! variances a window adds on several axes are one fold instead of one per axis (the
+//! same Σ to rounding, within the stiff suite's and the random-chain test's bounds). The
+//! batch lanes ([`crate::Chain::eval_batch`]) run the same program. A tape run through
+//! [`Tape::run_cov`] or [`Tape::run_factor`] goes kernel by kernel and gives the checked
+//! kernels' bits.
+//!
+//! A chain's first evaluation in a layout and form is not recorded (a renderer's
+//! per-path chain runs once): its operators run on the unchecked kernels directly
+//! (`Direct`), with the same finiteness checks and the same checked re-run on failure.
 //!
 //! Recording needs no special support from operators: a tape records by applying each
 //! operator to a [`Recorder`], a [`Spectrum`] whose raw kernels append to the tape. An
