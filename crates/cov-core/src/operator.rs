@@ -225,8 +225,21 @@ impl Chain {
     /// kernels ([`Direct`]). Otherwise the checked path, which finds and reports the
     /// failing step and leaves Σ as it was.
     fn apply_fast<K: Kernels>(&self, k: &mut K) -> Result<(), CovError> {
+        let tape = self.tape::<K>(false);
+        if let Some(tape) = tape
+            && K::FORM == Form::Covariance
+            && tape.program().is_some()
+        {
+            // The compiled covariance program works on its own copy and writes `k` only
+            // when it ran clean.
+            return if tape.run(k) {
+                Ok(())
+            } else {
+                self.apply_checked(k)
+            };
+        }
         let mut work = *k;
-        let clean = match self.tape::<K>(false) {
+        let clean = match tape {
             Some(tape) => tape.run(&mut work),
             None => self.apply_direct(&mut work),
         };

@@ -54,7 +54,6 @@
 //! # Ok::<(), CovError>(())
 //! ```
 
-use std::any::Any;
 use std::cell::Cell;
 use std::sync::{Arc, OnceLock};
 
@@ -145,9 +144,9 @@ pub struct Tape {
     dim: usize,
     form: Form,
     kernels: Vec<Kernel>,
-    /// The kernels lowered for the concrete form (`Vec<Instr>`), built by
-    /// [`Tape::prepare`] for tapes that run many times (a [`crate::Chain`]'s).
-    program: OnceLock<Box<dyn Any + Send + Sync>>,
+    /// The kernels lowered for the tape's form and layout, built by [`Tape::prepare`]
+    /// for tapes that run many times (a [`crate::Chain`]'s).
+    program: OnceLock<Vec<Instr>>,
 }
 
 impl Clone for Tape {
@@ -467,22 +466,19 @@ impl Tape {
     /// times ([`plan`]): constant-index kernels, pairs of them as one call, and in
     /// square-root form a run of variances as one window.
     pub(crate) fn prepare<K: Kernels>(&self) {
-        self.program.get_or_init(|| {
-            let prog: Vec<Instr> = plan::<K>(&self.kernels);
-            Box::new(prog)
-        });
+        if K::DIM == self.dim && K::FORM == self.form {
+            self.program.get_or_init(|| plan::<K>(&self.kernels));
+        }
     }
 
     /// The compiled program, once [`Tape::prepare`] has built it.
     pub(crate) fn program(&self) -> Option<&[Instr]> {
-        self.program
-            .get()
-            .and_then(|p| p.downcast_ref::<Vec<Instr>>())
-            .map(|p| p.as_slice())
+        self.program.get().map(|p| p.as_slice())
     }
 
     /// Runs every kernel on `k` in place; false if the layout or form does not match,
-    /// an opaque step failed or the result is not finite (`k` is then garbage).
+    /// an opaque step failed or the result is not finite (`k` is then garbage, except
+    /// for a prepared tape in covariance form, which leaves `k` as it was).
     ///
     /// A prepared tape runs its program on a local copy of Σ, every simple kernel
     /// dispatched to its constant-index form inlined here, so that the compiler may keep
