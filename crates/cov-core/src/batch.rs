@@ -269,7 +269,7 @@ fn lower_lanes<const N: usize>(tape: &Tape) -> Option<Vec<LaneOp>> {
     tape.program()?
         .iter()
         .map(|ins| match *ins {
-            Instr::Op { code, i, j, a, b } => Some(LaneOp {
+            Instr::Op { code, i, j, a, b, .. } => Some(LaneOp {
                 code,
                 i,
                 j,

@@ -199,6 +199,8 @@ pub(crate) enum Instr {
         a: f64,
         /// Second parameter.
         b: f64,
+        /// The code of [`flat_dispatch!`] (from the four fields above).
+        f: u8,
     },
     Window(Box<Block>),
     General(usize),
@@ -263,6 +265,7 @@ fn pair<K: Kernels>(a: &Kernel, b: &Kernel) -> Option<Instr> {
             j: 0,
             a,
             b,
+            f: flat(code, 0, 0),
         })
     };
     match (a, b) {
@@ -344,6 +347,269 @@ macro_rules! const_index {
     }};
 }
 
+/// `match` on a flat instruction code ([`flat`]) with one literal arm per kernel and
+/// index pair, each binding its indices as constants: a single jump table per
+/// instruction, where matching the kind and then the indices took two or three.
+macro_rules! flat_dispatch {
+    (
+        $code:expr;
+        shear |$si:ident, $sj:ident| $shear:expr;
+        rotate |$ri:ident, $rj:ident| $rotate:expr;
+        scale |$ci:ident| $scale:expr;
+        variance |$vi:ident| $variance:expr;
+        lobe |$li:ident| $lobe:expr;
+        pairs $pxu:expr, $pux:expr, $prf:expr, $puv:expr, $pxy:expr $(,)?
+    ) => {
+        match $code {
+            1 => {
+                let ($si, $sj): (usize, usize) = (0, 1);
+                $shear
+            }
+            2 => {
+                let ($si, $sj): (usize, usize) = (0, 2);
+                $shear
+            }
+            3 => {
+                let ($si, $sj): (usize, usize) = (0, 3);
+                $shear
+            }
+            4 => {
+                let ($si, $sj): (usize, usize) = (0, 4);
+                $shear
+            }
+            5 => {
+                let ($si, $sj): (usize, usize) = (1, 0);
+                $shear
+            }
+            7 => {
+                let ($si, $sj): (usize, usize) = (1, 2);
+                $shear
+            }
+            8 => {
+                let ($si, $sj): (usize, usize) = (1, 3);
+                $shear
+            }
+            9 => {
+                let ($si, $sj): (usize, usize) = (1, 4);
+                $shear
+            }
+            10 => {
+                let ($si, $sj): (usize, usize) = (2, 0);
+                $shear
+            }
+            11 => {
+                let ($si, $sj): (usize, usize) = (2, 1);
+                $shear
+            }
+            13 => {
+                let ($si, $sj): (usize, usize) = (2, 3);
+                $shear
+            }
+            14 => {
+                let ($si, $sj): (usize, usize) = (2, 4);
+                $shear
+            }
+            15 => {
+                let ($si, $sj): (usize, usize) = (3, 0);
+                $shear
+            }
+            16 => {
+                let ($si, $sj): (usize, usize) = (3, 1);
+                $shear
+            }
+            17 => {
+                let ($si, $sj): (usize, usize) = (3, 2);
+                $shear
+            }
+            19 => {
+                let ($si, $sj): (usize, usize) = (3, 4);
+                $shear
+            }
+            20 => {
+                let ($si, $sj): (usize, usize) = (4, 0);
+                $shear
+            }
+            21 => {
+                let ($si, $sj): (usize, usize) = (4, 1);
+                $shear
+            }
+            22 => {
+                let ($si, $sj): (usize, usize) = (4, 2);
+                $shear
+            }
+            23 => {
+                let ($si, $sj): (usize, usize) = (4, 3);
+                $shear
+            }
+            26 => {
+                let ($ri, $rj): (usize, usize) = (0, 1);
+                $rotate
+            }
+            27 => {
+                let ($ri, $rj): (usize, usize) = (0, 2);
+                $rotate
+            }
+            28 => {
+                let ($ri, $rj): (usize, usize) = (0, 3);
+                $rotate
+            }
+            29 => {
+                let ($ri, $rj): (usize, usize) = (0, 4);
+                $rotate
+            }
+            30 => {
+                let ($ri, $rj): (usize, usize) = (1, 0);
+                $rotate
+            }
+            32 => {
+                let ($ri, $rj): (usize, usize) = (1, 2);
+                $rotate
+            }
+            33 => {
+                let ($ri, $rj): (usize, usize) = (1, 3);
+                $rotate
+            }
+            34 => {
+                let ($ri, $rj): (usize, usize) = (1, 4);
+                $rotate
+            }
+            35 => {
+                let ($ri, $rj): (usize, usize) = (2, 0);
+                $rotate
+            }
+            36 => {
+                let ($ri, $rj): (usize, usize) = (2, 1);
+                $rotate
+            }
+            38 => {
+                let ($ri, $rj): (usize, usize) = (2, 3);
+                $rotate
+            }
+            39 => {
+                let ($ri, $rj): (usize, usize) = (2, 4);
+                $rotate
+            }
+            40 => {
+                let ($ri, $rj): (usize, usize) = (3, 0);
+                $rotate
+            }
+            41 => {
+                let ($ri, $rj): (usize, usize) = (3, 1);
+                $rotate
+            }
+            42 => {
+                let ($ri, $rj): (usize, usize) = (3, 2);
+                $rotate
+            }
+            44 => {
+                let ($ri, $rj): (usize, usize) = (3, 4);
+                $rotate
+            }
+            45 => {
+                let ($ri, $rj): (usize, usize) = (4, 0);
+                $rotate
+            }
+            46 => {
+                let ($ri, $rj): (usize, usize) = (4, 1);
+                $rotate
+            }
+            47 => {
+                let ($ri, $rj): (usize, usize) = (4, 2);
+                $rotate
+            }
+            48 => {
+                let ($ri, $rj): (usize, usize) = (4, 3);
+                $rotate
+            }
+            50 => {
+                let $ci: usize = 0;
+                $scale
+            }
+            51 => {
+                let $ci: usize = 1;
+                $scale
+            }
+            52 => {
+                let $ci: usize = 2;
+                $scale
+            }
+            53 => {
+                let $ci: usize = 3;
+                $scale
+            }
+            54 => {
+                let $ci: usize = 4;
+                $scale
+            }
+            55 => {
+                let $vi: usize = 0;
+                $variance
+            }
+            56 => {
+                let $vi: usize = 1;
+                $variance
+            }
+            57 => {
+                let $vi: usize = 2;
+                $variance
+            }
+            58 => {
+                let $vi: usize = 3;
+                $variance
+            }
+            59 => {
+                let $vi: usize = 4;
+                $variance
+            }
+            60 => {
+                let $li: usize = 0;
+                $lobe
+            }
+            61 => {
+                let $li: usize = 1;
+                $lobe
+            }
+            62 => {
+                let $li: usize = 2;
+                $lobe
+            }
+            63 => {
+                let $li: usize = 3;
+                $lobe
+            }
+            64 => {
+                let $li: usize = 4;
+                $lobe
+            }
+            65 => $pxu,
+            66 => $pux,
+            67 => $prf,
+            68 => $puv,
+            69 => $pxy,
+            _ => {}
+        }
+    };
+}
+
+/// The flat code of an instruction for [`flat_dispatch!`]: shears 0–24 and rotations
+/// 25–49 (`5i + j`), scales 50–54, variances 55–59 and lobes 60–64 (`i`), the pairs
+/// 65–69.
+fn flat(code: Code, i: u8, j: u8) -> u8 {
+    let (i, j) = (i.min(4), j.min(4));
+    match code {
+        Code::Shear => 5 * i + j,
+        Code::Rotate => 25 + 5 * i + j,
+        Code::Scale => 50 + i,
+        Code::AddVariance => 55 + i,
+        Code::Lobe1 => 60 + i,
+        Code::ShearXU => 65,
+        Code::ShearUX => 66,
+        Code::RotateFrame => 67,
+        Code::ScaleUV => 68,
+        Code::VarianceXY => 69,
+    }
+}
+
 pub(crate) use {const_index, const_pair};
 
 /// Lowers kernel `q` for the concrete form `K`: a simple kernel with indices in range
@@ -351,7 +617,14 @@ pub(crate) use {const_index, const_pair};
 /// as the tape's general kernel.
 fn lower<K: Kernels>(kernel: &Kernel, q: usize) -> Instr {
     let fits = |i: u8| (i as usize) < K::DIM;
-    let op = |code, i, j, a, b| Instr::Op { code, i, j, a, b };
+    let op = |code, i, j, a, b| Instr::Op {
+        code,
+        i,
+        j,
+        a,
+        b,
+        f: flat(code, i, j),
+    };
     match *kernel {
         Kernel::Shear { i, j, s } if fits(i) && fits(j) && i != j => op(Code::Shear, i, j, s, 0.0),
         Kernel::Rotate { i, j, c, s } if fits(i) && fits(j) && i != j => op(Code::Rotate, i, j, c, s),
@@ -519,38 +792,34 @@ impl Tape {
         let local = K::FORM == Form::Covariance;
         for ins in prog {
             match *ins {
-                Instr::Op { code, i, j, a, b } => match code {
-                    Code::Shear => const_pair!(i, j, |ci, cj| w.k_shear(ci, cj, a)),
-                    Code::Rotate => const_pair!(i, j, |ci, cj| w.k_rotate(ci, cj, a, b)),
-                    Code::Scale => const_index!(i, |ci| w.k_scale(ci, a)),
-                    Code::AddVariance => const_index!(i, |ci| w.k_add_variance(ci, a)),
-                    Code::Lobe1 => {
+                Instr::Op { a, b, f, .. } => flat_dispatch!(f;
+                    shear |ci, cj| w.k_shear(ci, cj, a);
+                    rotate |ci, cj| w.k_rotate(ci, cj, a, b);
+                    scale |ci| w.k_scale(ci, a);
+                    variance |ci| w.k_add_variance(ci, a);
+                    lobe |ci| {
                         if !w.all_finite() {
                             return false;
                         }
-                        const_index!(i, |ci| w.k_lobe_1(ci, a))
-                    }
-                    Code::ShearXU => {
+                        w.k_lobe_1(ci, a)
+                    };
+                    pairs {
                         w.k_shear(0, 2, a);
                         w.k_shear(1, 3, b);
-                    }
-                    Code::ShearUX => {
+                    }, {
                         w.k_shear(2, 0, a);
                         w.k_shear(3, 1, b);
-                    }
-                    Code::RotateFrame => {
+                    }, {
                         w.k_rotate(0, 1, a, b);
                         w.k_rotate(2, 3, a, b);
-                    }
-                    Code::ScaleUV => {
+                    }, {
                         w.k_scale(2, a);
                         w.k_scale(3, b);
-                    }
-                    Code::VarianceXY => {
+                    }, {
                         w.k_add_variance(0, a);
                         w.k_add_variance(1, b);
                     }
-                },
+                ),
                 Instr::Window(ref b) => {
                     if !w.all_finite() {
                         return false;
