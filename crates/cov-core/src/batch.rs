@@ -13,7 +13,7 @@
 use rayon::prelude::*;
 
 use crate::form::Kernels;
-use crate::tape::{Code, Direct, Instr, const_index, const_pair};
+use crate::tape::{Direct, Instr, flat_dispatch};
 use crate::{Chain, Cov, CovError, CovFactor, Form, Spectrum, Tape};
 
 /// States stored side by side in a structure-of-arrays group: each entry of Σ is one
@@ -64,7 +64,7 @@ impl Chain {
         let (tape, lanes) = match form {
             Form::Covariance => {
                 let tape = self.tape::<Cov<N>>(true);
-                (tape, tape.and_then(lower_lanes::<N>))
+                (tape, tape.and_then(lower_lanes))
             }
             Form::SquareRoot => (self.tape::<CovFactor<N>>(true), None),
         };
@@ -253,29 +253,17 @@ where
     failed
 }
 
-/// One instruction of the lane program: the compiled program's [`Instr::Op`].
-#[derive(Clone, Copy, Debug)]
-pub(crate) struct LaneOp {
-    code: Code,
-    i: u8,
-    j: u8,
-    x: f64,
-    y: f64,
-}
+/// One instruction of the lane program: the compiled program's [`Instr::Op`] (its flat
+/// code and two parameters).
+type LaneOp = (u8, f64, f64);
 
 /// The tape's compiled program as lane instructions (`None` if an instruction has no
 /// lane form, a window or a general kernel: the states then run one by one).
-fn lower_lanes<const N: usize>(tape: &Tape) -> Option<Vec<LaneOp>> {
+fn lower_lanes(tape: &Tape) -> Option<Vec<LaneOp>> {
     tape.program()?
         .iter()
         .map(|ins| match *ins {
-            Instr::Op { code, i, j, a, b, .. } => Some(LaneOp {
-                code,
-                i,
-                j,
-                x: a,
-                y: b,
-            }),
+            Instr::Op { f, a, b } => Some((f, a, b)),
             _ => None,
         })
         .collect()
@@ -324,39 +312,34 @@ fn run_chunk<const N: usize>(prog: &[LaneOp], chunk: &mut [Cov<N>], poisoned: &m
 /// kernel, inlined here (and so compiled for the instruction set of [`run_chunk`]).
 #[inline(always)]
 fn run_group<const N: usize>(prog: &[LaneOp], a: &mut Lanes, bad: &mut [bool; LANES]) {
-    for k in prog {
-        let (x, y) = (k.x, k.y);
-        match k.code {
-            Code::Shear => const_pair!(k.i, k.j, |i, j| shear::<N>(a, i, j, x)),
-            Code::Rotate => const_pair!(k.i, k.j, |i, j| rotate::<N>(a, i, j, x, y)),
-            Code::Scale => const_index!(k.i, |i| scale::<N>(a, i, x)),
-            Code::AddVariance => const_index!(k.i, |i| add_variance::<N>(a, i, x)),
-            Code::Lobe1 => {
+    for &(f, x, y) in prog {
+        flat_dispatch!(f;
+            shear |i, j| shear::<N>(a, i, j, x);
+            rotate |i, j| rotate::<N>(a, i, j, x, y);
+            scale |i| scale::<N>(a, i, x);
+            variance |i| add_variance::<N>(a, i, x);
+            lobe |i| {
                 // As the scalar tape: a lobe may hide an ∞, so check before it.
                 mark_non_finite::<N>(a, bad);
-                const_index!(k.i, |i| lobe_1::<N>(a, i, x))
-            }
-            Code::ShearXU => {
+                lobe_1::<N>(a, i, x)
+            };
+            pairs {
                 shear::<N>(a, 0, 2, x);
                 shear::<N>(a, 1, 3, y);
-            }
-            Code::ShearUX => {
+            }, {
                 shear::<N>(a, 2, 0, x);
                 shear::<N>(a, 3, 1, y);
-            }
-            Code::RotateFrame => {
+            }, {
                 rotate::<N>(a, 0, 1, x, y);
                 rotate::<N>(a, 2, 3, x, y);
-            }
-            Code::ScaleUV => {
+            }, {
                 scale::<N>(a, 2, x);
                 scale::<N>(a, 3, y);
-            }
-            Code::VarianceXY => {
+            }, {
                 add_variance::<N>(a, 0, x);
                 add_variance::<N>(a, 1, y);
             }
-        }
+        )
     }
 }
 

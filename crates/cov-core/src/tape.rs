@@ -164,7 +164,7 @@ impl Clone for Tape {
 /// runs), or a pair of kernels that one operator makes on the transverse planes (x, u)
 /// and (y, v) of layouts 4 and 5 ([`pair`]).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub(crate) enum Code {
+enum Code {
     Shear,
     Rotate,
     Scale,
@@ -187,20 +187,15 @@ pub(crate) enum Code {
 /// several variances (square-root form), or the general kernel `q` of the tape.
 #[derive(Debug)]
 pub(crate) enum Instr {
-    /// A simple kernel or a transverse pair (indices below the layout size).
+    /// A simple kernel or a transverse pair (indices below the layout size), as the
+    /// flat code of [`flat_dispatch!`], with its two parameters.
     Op {
-        /// What it does.
-        code: Code,
-        /// First index (unused by pairs).
-        i: u8,
-        /// Second index (shears and rotations).
-        j: u8,
+        /// The code ([`flat`]).
+        f: u8,
         /// First parameter.
         a: f64,
         /// Second parameter.
         b: f64,
-        /// The code of [`flat_dispatch!`] (from the four fields above).
-        f: u8,
     },
     Window(Box<Block>),
     General(usize),
@@ -260,12 +255,9 @@ fn pair<K: Kernels>(a: &Kernel, b: &Kernel) -> Option<Instr> {
     }
     let op = |code, a, b| {
         Some(Instr::Op {
-            code,
-            i: 0,
-            j: 0,
+            f: flat(code, 0, 0),
             a,
             b,
-            f: flat(code, 0, 0),
         })
     };
     match (a, b) {
@@ -290,66 +282,11 @@ fn pair<K: Kernels>(a: &Kernel, b: &Kernel) -> Option<Instr> {
     }
 }
 
-/// `$body` with `$ci`, `$cj` bound to the constants equal to the run-time indices
-/// `($i, $j)` (distinct, below 5), so that each arm is the closed-form update of the
-/// few entries it touches.
-macro_rules! const_pair {
-    ($i:expr, $j:expr, |$ci:ident, $cj:ident| $body:expr) => {{
-        macro_rules! arm {
-            ($x:literal, $y:literal) => {{
-                let ($ci, $cj): (usize, usize) = ($x, $y);
-                $body
-            }};
-        }
-        match ($i, $j) {
-            (0, 1) => arm!(0, 1),
-            (0, 2) => arm!(0, 2),
-            (0, 3) => arm!(0, 3),
-            (0, 4) => arm!(0, 4),
-            (1, 0) => arm!(1, 0),
-            (1, 2) => arm!(1, 2),
-            (1, 3) => arm!(1, 3),
-            (1, 4) => arm!(1, 4),
-            (2, 0) => arm!(2, 0),
-            (2, 1) => arm!(2, 1),
-            (2, 3) => arm!(2, 3),
-            (2, 4) => arm!(2, 4),
-            (3, 0) => arm!(3, 0),
-            (3, 1) => arm!(3, 1),
-            (3, 2) => arm!(3, 2),
-            (3, 4) => arm!(3, 4),
-            (4, 0) => arm!(4, 0),
-            (4, 1) => arm!(4, 1),
-            (4, 2) => arm!(4, 2),
-            (4, 3) => arm!(4, 3),
-            _ => {}
-        }
-    }};
-}
-
-/// `$body` with `$ci` bound to the constant equal to the run-time index `$i` (below 5).
-macro_rules! const_index {
-    ($i:expr, |$ci:ident| $body:expr) => {{
-        macro_rules! arm {
-            ($x:literal) => {{
-                let $ci: usize = $x;
-                $body
-            }};
-        }
-        match $i {
-            0 => arm!(0),
-            1 => arm!(1),
-            2 => arm!(2),
-            3 => arm!(3),
-            4 => arm!(4),
-            _ => {}
-        }
-    }};
-}
-
 /// `match` on a flat instruction code ([`flat`]) with one literal arm per kernel and
 /// index pair, each binding its indices as constants: a single jump table per
-/// instruction, where matching the kind and then the indices took two or three.
+/// instruction, where matching the kind and then the indices took two or three. The
+/// compiled program ([`Tape::run`]) and the batch lanes dispatch through it.
+#[rustfmt::skip]
 macro_rules! flat_dispatch {
     (
         $code:expr;
@@ -361,226 +298,61 @@ macro_rules! flat_dispatch {
         pairs $pxu:expr, $pux:expr, $prf:expr, $puv:expr, $pxy:expr $(,)?
     ) => {
         match $code {
-            1 => {
-                let ($si, $sj): (usize, usize) = (0, 1);
-                $shear
-            }
-            2 => {
-                let ($si, $sj): (usize, usize) = (0, 2);
-                $shear
-            }
-            3 => {
-                let ($si, $sj): (usize, usize) = (0, 3);
-                $shear
-            }
-            4 => {
-                let ($si, $sj): (usize, usize) = (0, 4);
-                $shear
-            }
-            5 => {
-                let ($si, $sj): (usize, usize) = (1, 0);
-                $shear
-            }
-            7 => {
-                let ($si, $sj): (usize, usize) = (1, 2);
-                $shear
-            }
-            8 => {
-                let ($si, $sj): (usize, usize) = (1, 3);
-                $shear
-            }
-            9 => {
-                let ($si, $sj): (usize, usize) = (1, 4);
-                $shear
-            }
-            10 => {
-                let ($si, $sj): (usize, usize) = (2, 0);
-                $shear
-            }
-            11 => {
-                let ($si, $sj): (usize, usize) = (2, 1);
-                $shear
-            }
-            13 => {
-                let ($si, $sj): (usize, usize) = (2, 3);
-                $shear
-            }
-            14 => {
-                let ($si, $sj): (usize, usize) = (2, 4);
-                $shear
-            }
-            15 => {
-                let ($si, $sj): (usize, usize) = (3, 0);
-                $shear
-            }
-            16 => {
-                let ($si, $sj): (usize, usize) = (3, 1);
-                $shear
-            }
-            17 => {
-                let ($si, $sj): (usize, usize) = (3, 2);
-                $shear
-            }
-            19 => {
-                let ($si, $sj): (usize, usize) = (3, 4);
-                $shear
-            }
-            20 => {
-                let ($si, $sj): (usize, usize) = (4, 0);
-                $shear
-            }
-            21 => {
-                let ($si, $sj): (usize, usize) = (4, 1);
-                $shear
-            }
-            22 => {
-                let ($si, $sj): (usize, usize) = (4, 2);
-                $shear
-            }
-            23 => {
-                let ($si, $sj): (usize, usize) = (4, 3);
-                $shear
-            }
-            26 => {
-                let ($ri, $rj): (usize, usize) = (0, 1);
-                $rotate
-            }
-            27 => {
-                let ($ri, $rj): (usize, usize) = (0, 2);
-                $rotate
-            }
-            28 => {
-                let ($ri, $rj): (usize, usize) = (0, 3);
-                $rotate
-            }
-            29 => {
-                let ($ri, $rj): (usize, usize) = (0, 4);
-                $rotate
-            }
-            30 => {
-                let ($ri, $rj): (usize, usize) = (1, 0);
-                $rotate
-            }
-            32 => {
-                let ($ri, $rj): (usize, usize) = (1, 2);
-                $rotate
-            }
-            33 => {
-                let ($ri, $rj): (usize, usize) = (1, 3);
-                $rotate
-            }
-            34 => {
-                let ($ri, $rj): (usize, usize) = (1, 4);
-                $rotate
-            }
-            35 => {
-                let ($ri, $rj): (usize, usize) = (2, 0);
-                $rotate
-            }
-            36 => {
-                let ($ri, $rj): (usize, usize) = (2, 1);
-                $rotate
-            }
-            38 => {
-                let ($ri, $rj): (usize, usize) = (2, 3);
-                $rotate
-            }
-            39 => {
-                let ($ri, $rj): (usize, usize) = (2, 4);
-                $rotate
-            }
-            40 => {
-                let ($ri, $rj): (usize, usize) = (3, 0);
-                $rotate
-            }
-            41 => {
-                let ($ri, $rj): (usize, usize) = (3, 1);
-                $rotate
-            }
-            42 => {
-                let ($ri, $rj): (usize, usize) = (3, 2);
-                $rotate
-            }
-            44 => {
-                let ($ri, $rj): (usize, usize) = (3, 4);
-                $rotate
-            }
-            45 => {
-                let ($ri, $rj): (usize, usize) = (4, 0);
-                $rotate
-            }
-            46 => {
-                let ($ri, $rj): (usize, usize) = (4, 1);
-                $rotate
-            }
-            47 => {
-                let ($ri, $rj): (usize, usize) = (4, 2);
-                $rotate
-            }
-            48 => {
-                let ($ri, $rj): (usize, usize) = (4, 3);
-                $rotate
-            }
-            50 => {
-                let $ci: usize = 0;
-                $scale
-            }
-            51 => {
-                let $ci: usize = 1;
-                $scale
-            }
-            52 => {
-                let $ci: usize = 2;
-                $scale
-            }
-            53 => {
-                let $ci: usize = 3;
-                $scale
-            }
-            54 => {
-                let $ci: usize = 4;
-                $scale
-            }
-            55 => {
-                let $vi: usize = 0;
-                $variance
-            }
-            56 => {
-                let $vi: usize = 1;
-                $variance
-            }
-            57 => {
-                let $vi: usize = 2;
-                $variance
-            }
-            58 => {
-                let $vi: usize = 3;
-                $variance
-            }
-            59 => {
-                let $vi: usize = 4;
-                $variance
-            }
-            60 => {
-                let $li: usize = 0;
-                $lobe
-            }
-            61 => {
-                let $li: usize = 1;
-                $lobe
-            }
-            62 => {
-                let $li: usize = 2;
-                $lobe
-            }
-            63 => {
-                let $li: usize = 3;
-                $lobe
-            }
-            64 => {
-                let $li: usize = 4;
-                $lobe
-            }
+            1 => { let ($si, $sj): (usize, usize) = (0, 1); $shear }
+            2 => { let ($si, $sj): (usize, usize) = (0, 2); $shear }
+            3 => { let ($si, $sj): (usize, usize) = (0, 3); $shear }
+            4 => { let ($si, $sj): (usize, usize) = (0, 4); $shear }
+            5 => { let ($si, $sj): (usize, usize) = (1, 0); $shear }
+            7 => { let ($si, $sj): (usize, usize) = (1, 2); $shear }
+            8 => { let ($si, $sj): (usize, usize) = (1, 3); $shear }
+            9 => { let ($si, $sj): (usize, usize) = (1, 4); $shear }
+            10 => { let ($si, $sj): (usize, usize) = (2, 0); $shear }
+            11 => { let ($si, $sj): (usize, usize) = (2, 1); $shear }
+            13 => { let ($si, $sj): (usize, usize) = (2, 3); $shear }
+            14 => { let ($si, $sj): (usize, usize) = (2, 4); $shear }
+            15 => { let ($si, $sj): (usize, usize) = (3, 0); $shear }
+            16 => { let ($si, $sj): (usize, usize) = (3, 1); $shear }
+            17 => { let ($si, $sj): (usize, usize) = (3, 2); $shear }
+            19 => { let ($si, $sj): (usize, usize) = (3, 4); $shear }
+            20 => { let ($si, $sj): (usize, usize) = (4, 0); $shear }
+            21 => { let ($si, $sj): (usize, usize) = (4, 1); $shear }
+            22 => { let ($si, $sj): (usize, usize) = (4, 2); $shear }
+            23 => { let ($si, $sj): (usize, usize) = (4, 3); $shear }
+            26 => { let ($ri, $rj): (usize, usize) = (0, 1); $rotate }
+            27 => { let ($ri, $rj): (usize, usize) = (0, 2); $rotate }
+            28 => { let ($ri, $rj): (usize, usize) = (0, 3); $rotate }
+            29 => { let ($ri, $rj): (usize, usize) = (0, 4); $rotate }
+            30 => { let ($ri, $rj): (usize, usize) = (1, 0); $rotate }
+            32 => { let ($ri, $rj): (usize, usize) = (1, 2); $rotate }
+            33 => { let ($ri, $rj): (usize, usize) = (1, 3); $rotate }
+            34 => { let ($ri, $rj): (usize, usize) = (1, 4); $rotate }
+            35 => { let ($ri, $rj): (usize, usize) = (2, 0); $rotate }
+            36 => { let ($ri, $rj): (usize, usize) = (2, 1); $rotate }
+            38 => { let ($ri, $rj): (usize, usize) = (2, 3); $rotate }
+            39 => { let ($ri, $rj): (usize, usize) = (2, 4); $rotate }
+            40 => { let ($ri, $rj): (usize, usize) = (3, 0); $rotate }
+            41 => { let ($ri, $rj): (usize, usize) = (3, 1); $rotate }
+            42 => { let ($ri, $rj): (usize, usize) = (3, 2); $rotate }
+            44 => { let ($ri, $rj): (usize, usize) = (3, 4); $rotate }
+            45 => { let ($ri, $rj): (usize, usize) = (4, 0); $rotate }
+            46 => { let ($ri, $rj): (usize, usize) = (4, 1); $rotate }
+            47 => { let ($ri, $rj): (usize, usize) = (4, 2); $rotate }
+            48 => { let ($ri, $rj): (usize, usize) = (4, 3); $rotate }
+            50 => { let $ci: usize = 0; $scale }
+            51 => { let $ci: usize = 1; $scale }
+            52 => { let $ci: usize = 2; $scale }
+            53 => { let $ci: usize = 3; $scale }
+            54 => { let $ci: usize = 4; $scale }
+            55 => { let $vi: usize = 0; $variance }
+            56 => { let $vi: usize = 1; $variance }
+            57 => { let $vi: usize = 2; $variance }
+            58 => { let $vi: usize = 3; $variance }
+            59 => { let $vi: usize = 4; $variance }
+            60 => { let $li: usize = 0; $lobe }
+            61 => { let $li: usize = 1; $lobe }
+            62 => { let $li: usize = 2; $lobe }
+            63 => { let $li: usize = 3; $lobe }
+            64 => { let $li: usize = 4; $lobe }
             65 => $pxu,
             66 => $pux,
             67 => $prf,
@@ -610,7 +382,7 @@ fn flat(code: Code, i: u8, j: u8) -> u8 {
     }
 }
 
-pub(crate) use {const_index, const_pair};
+pub(crate) use flat_dispatch;
 
 /// Lowers kernel `q` for the concrete form `K`: a simple kernel with indices in range
 /// becomes an [`Instr::Op`] (its indices constants when it runs); anything else runs
@@ -618,12 +390,9 @@ pub(crate) use {const_index, const_pair};
 fn lower<K: Kernels>(kernel: &Kernel, q: usize) -> Instr {
     let fits = |i: u8| (i as usize) < K::DIM;
     let op = |code, i, j, a, b| Instr::Op {
-        code,
-        i,
-        j,
+        f: flat(code, i, j),
         a,
         b,
-        f: flat(code, i, j),
     };
     match *kernel {
         Kernel::Shear { i, j, s } if fits(i) && fits(j) && i != j => op(Code::Shear, i, j, s, 0.0),
@@ -792,7 +561,7 @@ impl Tape {
         let local = K::FORM == Form::Covariance;
         for ins in prog {
             match *ins {
-                Instr::Op { a, b, f, .. } => flat_dispatch!(f;
+                Instr::Op { f, a, b } => flat_dispatch!(f;
                     shear |ci, cj| w.k_shear(ci, cj, a);
                     rotate |ci, cj| w.k_rotate(ci, cj, a, b);
                     scale |ci| w.k_scale(ci, a);
