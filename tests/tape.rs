@@ -15,7 +15,7 @@ use covtrace::curvature::Curvature;
 use covtrace::occlusion::Window;
 use covtrace::projection::{Mirror, Project, RotateFrame, Unproject};
 use covtrace::travel::Travel;
-use covtrace::{AnyCov, Chain, Cov, CovError, CovFactor, Form, Kernel, Operator, Spectrum, Tape};
+use covtrace::{AnyCov, Chain, Cov, CovError, CovFactor, CovLanes, Form, Kernel, Operator, Spectrum, Tape};
 use proptest::prelude::*;
 
 /// One kernel call as an operator, on the axis indices of the layout.
@@ -269,6 +269,15 @@ fn batch_matches_scalar<const N: usize>(chain: &Chain, seeds: &[Vec<f64>]) {
             }
         }
         assert!(next.is_none(), "a state reported that did not fail");
+        if form == Form::Covariance {
+            // The same states stored structure-of-arrays: the same bits and failures.
+            let mut lanes: CovLanes<N> = starts.iter().copied().collect();
+            let failed_lanes = chain.eval_lanes(&mut lanes);
+            assert_eq!(lanes.to_vec(), batch, "N={N}: eval_lanes against eval_batch");
+            let render =
+                |f: &[(usize, CovError)]| f.iter().map(|(i, e)| format!("{i}: {e}")).collect::<Vec<_>>();
+            assert_eq!(render(&failed_lanes), render(&failed));
+        }
     }
 }
 
@@ -318,6 +327,95 @@ fn batch_reports_failing_states_by_index() {
     assert_eq!(states[3], before[3]);
     let want = chain.eval_in(Form::Covariance, before[1099]).unwrap();
     assert_eq!(states[1099], want);
+}
+
+#[test]
+fn an_overflow_is_not_hidden_by_a_later_lobe() {
+    // Σ_xx overflows (x scaled by ~1e200), then a lobe on another axis: the row of x
+    // cancels "to nothing" relative to ∞ and its snap would zero it, leaving a finite Σ.
+    // The compiled program, the lanes and the per-state batch check only at the end, so
+    // the snap must keep the ∞ visible: every path reports the checked path's error.
+    let chain = Chain::new().with(K(1, 0.0, 1e200)).with(K(12, 0.0, 5.0));
+    // Σ_xu = 0 keeps the lobe's own update of row x finite (∞ − 0·0), so only the snap
+    // decides whether the ∞ survives.
+    let c0 = Cov::<2>::from_diagonal([1.0, 1.0]).unwrap();
+    for form in [Form::Covariance, Form::SquareRoot] {
+        // The first evaluation runs checked (in square-root form the factor stays finite
+        // and Σ overflows when it is formed, which that path reports without a step).
+        let want = chain.eval_in(form, c0).unwrap_err().to_string();
+        if form == Form::Covariance {
+            assert!(want.starts_with("step 0 (K)"), "{want}");
+        }
+        for _ in 0..3 {
+            assert_eq!(chain.eval_in(form, c0).unwrap_err().to_string(), want);
+        }
+        let mut states = vec![c0; 100];
+        let failed = chain.eval_batch(form, &mut states);
+        assert_eq!(failed.len(), 100, "{form:?}");
+        assert_eq!(failed[99].1.to_string(), want);
+        assert!(states.iter().all(|s| *s == c0));
+        let mut states = vec![c0; 10];
+        let failed = covtrace::eval_batch_with(form, &mut states, |_, s| chain.apply(s));
+        assert_eq!(failed.len(), 10, "{form:?}");
+    }
+    let mut lanes: CovLanes<2> = std::iter::repeat_n(c0, 70).collect();
+    let failed = chain.eval_lanes(&mut lanes);
+    assert_eq!(
+        failed.iter().map(|(i, _)| *i).collect::<Vec<_>>(),
+        (0..70).collect::<Vec<_>>()
+    );
+    assert!(
+        lanes.iter().all(|s| s == c0),
+        "failed states are left as they were"
+    );
+}
+
+#[test]
+fn lanes_store_states_across_groups_and_report_by_index() {
+    // 1,100 states: chunks, groups and a ragged last group; states 3 and 700 overflow.
+    let seed: Vec<f64> = (0..25).map(|i| (i as f64 * 0.37).sin()).collect();
+    let chain = Chain::new()
+        .with(K(1, 0.0, 1e100))
+        .with(bounce(2.0, 0.6, 0.9, 0.4));
+    let mut states: Vec<Cov<4>> = (0..1100)
+        .map(|i| {
+            let mut c = start::<4>(&seed);
+            c.set(0, 0, c.get(0, 0) + i as f64);
+            c
+        })
+        .collect();
+    for i in [3, 700] {
+        states[i] = Cov::<4>::gaussian([1e-150, 1e-150, 1.0, 1.0]).unwrap();
+    }
+    let mut lanes = CovLanes::from(&states[..]);
+    assert_eq!(lanes.len(), 1100);
+    assert_eq!(lanes.to_vec(), states);
+    assert_eq!(lanes.get(1100), None);
+    let failed = chain.eval_lanes(&mut lanes);
+    assert_eq!(failed.iter().map(|(i, _)| *i).collect::<Vec<_>>(), vec![3, 700]);
+    assert!(
+        failed[1].1.to_string().starts_with("step 0 (K)"),
+        "{}",
+        failed[1].1
+    );
+    for i in [0, 3, 63, 64, 511, 512, 700, 1099] {
+        let want = chain.eval_in(Form::Covariance, states[i]).unwrap_or(states[i]);
+        assert_eq!(lanes.get(i), Some(want), "state {i}");
+    }
+    // Editing: set, push into a new group, extend, clear.
+    lanes.set(64, states[1]);
+    assert_eq!(lanes.get(64), Some(states[1]));
+    lanes.push(states[2]);
+    lanes.extend(states[..30].iter().copied());
+    assert_eq!(lanes.len(), 1131);
+    assert_eq!(lanes.get(1100), Some(states[2]));
+    assert_eq!(lanes.get(1130), Some(states[29]));
+    assert_eq!(
+        format!("{:?}", CovLanes::from(&states[..1])),
+        format!("[{:?}]", states[0])
+    );
+    lanes.clear();
+    assert!(lanes.is_empty() && chain.eval_lanes(&mut lanes).is_empty());
 }
 
 #[test]

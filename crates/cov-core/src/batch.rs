@@ -25,7 +25,11 @@ pub const LANES: usize = 64;
 /// States per parallel task.
 pub const CHUNK: usize = 512;
 
-type Lanes = [[f64; LANES]; 15];
+/// One entry of Σ over a group's [`LANES`] states.
+pub(crate) type Lane = [f64; LANES];
+
+/// A group as [`run_chunk`] holds it: every slot a layout may use.
+type Lanes = [Lane; 15];
 
 /// Packed index of `(i, j)`, as `Cov<N>` stores it.
 #[inline(always)]
@@ -92,7 +96,7 @@ impl Chain {
     }
 
     /// One state through the tape; on failure the checked path reports it.
-    fn run_one<const N: usize>(
+    pub(crate) fn run_one<const N: usize>(
         &self,
         tape: &Tape,
         form: Form,
@@ -123,7 +127,7 @@ impl Chain {
     /// reports the failing step, and the state is left as it was; or, if it succeeds
     /// (the square-root program folds a window's variances at once, which rounds
     /// differently from one fold per axis), its result is the state's.
-    fn report_failure<const N: usize>(
+    pub(crate) fn report_failure<const N: usize>(
         &self,
         form: Form,
         s: &mut Cov<N>,
@@ -255,11 +259,11 @@ where
 
 /// One instruction of the lane program: the compiled program's [`Instr::Op`] (its flat
 /// code and two parameters).
-type LaneOp = (u8, f64, f64);
+pub(crate) type LaneOp = (u8, f64, f64);
 
 /// The tape's compiled program as lane instructions (`None` if an instruction has no
 /// lane form, a window or a general kernel: the states then run one by one).
-fn lower_lanes(tape: &Tape) -> Option<Vec<LaneOp>> {
+pub(crate) fn lower_lanes(tape: &Tape) -> Option<Vec<LaneOp>> {
     tape.program()?
         .iter()
         .map(|ins| match *ins {
@@ -292,9 +296,9 @@ fn run_chunk<const N: usize>(prog: &[LaneOp], chunk: &mut [Cov<N>], poisoned: &m
                 a[e][l] = s[e];
             }
         }
+        run_group::<N>(prog, &mut a[..]);
         let mut bad = [false; LANES];
-        run_group::<N>(prog, &mut a, &mut bad);
-        mark_non_finite::<N>(&a, &mut bad);
+        mark_non_finite::<N>(&a[..], &mut bad);
         for (l, s) in group.iter_mut().enumerate() {
             if bad[l] {
                 poisoned.push(g * LANES + l);
@@ -308,21 +312,46 @@ fn run_chunk<const N: usize>(prog: &[LaneOp], chunk: &mut [Cov<N>], poisoned: &m
     }
 }
 
+/// Groups already stored structure-of-arrays ([`crate::CovLanes`]: `N(N+1)/2` lanes
+/// per group) through the lane program, in place: no transposition. Each group is
+/// copied first (a contiguous copy of its used entries); the lanes that become
+/// non-finite are restored from the copy and their index (group-relative to `groups`)
+/// pushed to `poisoned`.
+#[multiversion::multiversion(targets("x86_64+avx512f+avx512dq+avx512vl", "x86_64+avx2"))]
+pub(crate) fn run_groups<const N: usize>(prog: &[LaneOp], groups: &mut [Lane], poisoned: &mut Vec<usize>) {
+    let p = Cov::<N>::PACKED_LEN;
+    let mut backup: Lanes = [[0.0; LANES]; 15];
+    for (g, a) in groups.chunks_exact_mut(p).enumerate() {
+        backup[..p].copy_from_slice(a);
+        run_group::<N>(prog, a);
+        let mut bad = [false; LANES];
+        mark_non_finite::<N>(a, &mut bad);
+        if bad.contains(&true) {
+            for (l, _) in bad.iter().enumerate().filter(|(_, b)| **b) {
+                for (e, saved) in a.iter_mut().zip(&backup) {
+                    e[l] = saved[l];
+                }
+                poisoned.push(g * LANES + l);
+            }
+        }
+    }
+}
+
 /// The lane program on one group: each instruction dispatched to its constant-index
 /// kernel, inlined here (and so compiled for the instruction set of [`run_chunk`]).
 #[inline(always)]
-fn run_group<const N: usize>(prog: &[LaneOp], a: &mut Lanes, bad: &mut [bool; LANES]) {
+fn run_group<const N: usize>(prog: &[LaneOp], a: &mut [Lane]) {
+    // One length check for every constant index below (each is under `N(N+1)/2`).
+    assert!(a.len() >= Cov::<N>::PACKED_LEN, "a group holds every entry of Σ");
     for &(f, x, y) in prog {
         flat_dispatch!(f;
             shear |i, j| shear::<N>(a, i, j, x);
             rotate |i, j| rotate::<N>(a, i, j, x, y);
             scale |i| scale::<N>(a, i, x);
             variance |i| add_variance::<N>(a, i, x);
-            lobe |i| {
-                // As the scalar tape: a lobe may hide an ∞, so check before it.
-                mark_non_finite::<N>(a, bad);
-                lobe_1::<N>(a, i, x)
-            };
+            // The lane snap, as the scalar one, keeps an ∞ non-finite: the check at
+            // the end sees it (`Kernels::LOBE_1_KEEPS_NON_FINITE`).
+            lobe |i| lobe_1::<N>(a, i, x);
             pairs {
                 shear::<N>(a, 0, 2, x);
                 shear::<N>(a, 1, 3, y);
@@ -345,7 +374,7 @@ fn run_group<const N: usize>(prog: &[LaneOp], a: &mut Lanes, bad: &mut [bool; LA
 
 /// `Σ_ii += w`, lane by lane.
 #[inline(always)]
-fn add_variance<const N: usize>(a: &mut Lanes, i: usize, w: f64) {
+fn add_variance<const N: usize>(a: &mut [Lane], i: usize, w: f64) {
     for v in a[ix::<N>(i, i)].iter_mut() {
         *v += w;
     }
@@ -356,7 +385,7 @@ fn add_variance<const N: usize>(a: &mut Lanes, i: usize, w: f64) {
 /// finite (two vector operations per entry, no mask conversion per entry).
 #[inline(always)]
 #[allow(clippy::eq_op)] // `x − x` is the test itself: NaN exactly for a non-finite `x`.
-fn mark_non_finite<const N: usize>(a: &Lanes, poisoned: &mut [bool; LANES]) {
+fn mark_non_finite<const N: usize>(a: &[Lane], poisoned: &mut [bool; LANES]) {
     let mut acc = [0.0f64; LANES];
     for e in a.iter().take(N * (N + 1) / 2) {
         for l in 0..LANES {
@@ -374,7 +403,7 @@ fn mark_non_finite<const N: usize>(a: &Lanes, poisoned: &mut [bool; LANES]) {
 
 /// `Cov::shear_col` then commit, lane by lane.
 #[inline(always)]
-fn shear<const N: usize>(a: &mut Lanes, i: usize, j: usize, s: f64) {
+fn shear<const N: usize>(a: &mut [Lane], i: usize, j: usize, s: f64) {
     let (ii, ij, jj) = (ix::<N>(i, i), ix::<N>(i, j), ix::<N>(j, j));
     for l in 0..LANES {
         let diag = (a[jj][l] + s * (2.0 * a[ij][l] + s * a[ii][l])).abs();
@@ -390,7 +419,7 @@ fn shear<const N: usize>(a: &mut Lanes, i: usize, j: usize, s: f64) {
 
 /// `Cov::scale_col` then commit, lane by lane.
 #[inline(always)]
-fn scale<const N: usize>(a: &mut Lanes, i: usize, c: f64) {
+fn scale<const N: usize>(a: &mut [Lane], i: usize, c: f64) {
     for l in 0..LANES {
         for k in 0..N {
             let f = if k == i { c * c } else { c };
@@ -401,7 +430,7 @@ fn scale<const N: usize>(a: &mut Lanes, i: usize, c: f64) {
 
 /// `Cov::rotate_idx`, lane by lane.
 #[inline(always)]
-fn rotate<const N: usize>(a: &mut Lanes, i: usize, j: usize, c: f64, s: f64) {
+fn rotate<const N: usize>(a: &mut [Lane], i: usize, j: usize, c: f64, s: f64) {
     let (ii, ij, jj) = (ix::<N>(i, i), ix::<N>(i, j), ix::<N>(j, j));
     let cs = c * s;
     for l in 0..LANES {
@@ -422,7 +451,7 @@ fn rotate<const N: usize>(a: &mut Lanes, i: usize, j: usize, c: f64, s: f64) {
 
 /// `Cov::lobe_product_1` with its snap, lane by lane.
 #[inline(always)]
-fn lobe_1<const N: usize>(a: &mut Lanes, p: usize, s: f64) {
+fn lobe_1<const N: usize>(a: &mut [Lane], p: usize, s: f64) {
     let mut before = [[0.0; LANES]; 5];
     for (i, b) in before.iter_mut().enumerate().take(N) {
         *b = a[ix::<N>(i, i)];
@@ -472,10 +501,20 @@ fn lobe_1<const N: usize>(a: &mut Lanes, p: usize, s: f64) {
     for x in 0..N {
         let d = &a[ix::<N>(x, x)];
         let mut hit = false;
-        for l in 0..LANES {
-            let n = d[l] < 0.0 || before[x][l] <= 0.0 || (x != p && d[l] <= crate::SCHUR_SNAP * before[x][l]);
-            noise[x][l] = n;
-            hit |= n;
+        // Off the lobe's axis, `d < 0` implies `d <= SCHUR_SNAP · before` whenever
+        // `before > 0` (and `d` is NaN otherwise): the same decisions with one test less.
+        if x == p {
+            for l in 0..LANES {
+                let n = d[l] < 0.0 || before[x][l] <= 0.0;
+                noise[x][l] = n;
+                hit |= n;
+            }
+        } else {
+            for l in 0..LANES {
+                let n = before[x][l] <= 0.0 || d[l] <= crate::SCHUR_SNAP * before[x][l];
+                noise[x][l] = n;
+                hit |= n;
+            }
         }
         any[x] = hit;
     }
@@ -485,7 +524,7 @@ fn lobe_1<const N: usize>(a: &mut Lanes, p: usize, s: f64) {
                 let e = &mut a[ix::<N>(x, y)];
                 for l in 0..LANES {
                     if noise[x][l] || noise[y][l] {
-                        e[l] = 0.0;
+                        e[l] -= e[l];
                     }
                 }
             }

@@ -567,7 +567,7 @@ impl Tape {
                     scale |ci| w.k_scale(ci, a);
                     variance |ci| w.k_add_variance(ci, a);
                     lobe |ci| {
-                        if !w.all_finite() {
+                        if !K::LOBE_1_KEEPS_NON_FINITE && !w.all_finite() {
                             return false;
                         }
                         w.k_lobe_1(ci, a)
@@ -630,7 +630,7 @@ impl Tape {
             Kernel::AddVariance { i, w } => k.k_add_variance(*i as usize, *w),
             // A lobe may zero a row that held ∞: check before it.
             Kernel::Lobe1 { p, s } => {
-                if !k.all_finite() {
+                if !K::LOBE_1_KEEPS_NON_FINITE && !k.all_finite() {
                     return false;
                 }
                 k.k_lobe_1(*p as usize, *s)
@@ -866,7 +866,9 @@ impl<K: Kernels> Spectrum for Direct<'_, K> {
     }
     #[inline]
     fn raw_lobe_1(&mut self, op: &str, p: usize, s: f64) -> Result<(), CovError> {
-        self.finite(op)?;
+        if !K::LOBE_1_KEEPS_NON_FINITE {
+            self.finite(op)?;
+        }
         self.0.k_lobe_1(p, s);
         Ok(())
     }

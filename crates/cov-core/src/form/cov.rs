@@ -146,6 +146,9 @@ impl<const N: usize> Spectrum for Cov<N> {
 impl<const N: usize> Kernels for Cov<N> {
     const FORM: Form = Form::Covariance;
     const DIM: usize = N;
+    // `snap_cancelled` writes `v − v`, NaN for a non-finite `v`; every other entry of
+    // the lobe is a product or difference with the non-finite input (`∞·0` is NaN).
+    const LOBE_1_KEEPS_NON_FINITE: bool = true;
 
     #[inline(always)]
     fn k_shear(&mut self, i: usize, j: usize, s: f64) {
@@ -194,7 +197,7 @@ impl<const N: usize> Kernels for Cov<N> {
     }
 }
 
-/// The error of a Σ handed/// The error of a Σ handed to a spectrum of another layout.
+/// The error of a Σ handed to a spectrum of another layout.
 pub(crate) fn layout_mismatch(have: usize, got: usize) -> CovError {
     CovError::Shape {
         what: "Spectrum::assign".into(),
@@ -406,6 +409,7 @@ impl<const N: usize> Cov<N> {
     /// (`Σ_pp (S+Σ_pp)⁻¹ S`), not differences, so a large drop is information (a lobe of
     /// spectrum `S` on an angular spectrum `Σ_uu ≫ S` leaves `≈ S`), not cancellation.
     #[inline(always)]
+    #[allow(clippy::eq_op)] // `v − v` is the point: +0, or NaN for a non-finite `v`.
     fn snap_cancelled(&mut self, before: &[f64; N], p: &[usize]) {
         for a in 0..N {
             let v = self.get(a, a);
@@ -414,8 +418,11 @@ impl<const N: usize> Cov<N> {
             // integration cannot create content, only the general lobe's rounding can).
             let noise = v < 0.0 || before[a] <= 0.0 || (!p.contains(&a) && v <= SCHUR_SNAP * before[a]);
             if noise {
+                // `v − v`: +0 for a finite entry, NaN for ∞ or NaN, so a snap never
+                // hides an overflow (a compiled chain checks only at the end).
                 for b in 0..N {
-                    self.set(a, b, 0.0);
+                    let v = self.get(a, b);
+                    self.set(a, b, v - v);
                 }
             }
         }

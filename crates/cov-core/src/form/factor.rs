@@ -333,6 +333,8 @@ impl<const N: usize> Spectrum for CovFactor<N> {
 impl<const N: usize> Kernels for CovFactor<N> {
     const FORM: Form = Form::SquareRoot;
     const DIM: usize = N;
+    // Potter's update and its row snap are not audited for this: check before the lobe.
+    const LOBE_1_KEEPS_NON_FINITE: bool = false;
 
     #[inline(always)]
     fn k_shear(&mut self, i: usize, j: usize, s: f64) {

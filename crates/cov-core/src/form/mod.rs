@@ -49,6 +49,10 @@ pub(crate) trait Kernels: crate::Spectrum + Copy + Send + Sync + 'static {
     const FORM: crate::Form;
     /// The layout size.
     const DIM: usize;
+    /// Whether [`Kernels::k_lobe_1`] leaves some entry non-finite whenever its input
+    /// held one (its snap cannot hide an ∞), so that a compiled chain need not check
+    /// finiteness before it: the check at the end sees the overflow.
+    const LOBE_1_KEEPS_NON_FINITE: bool;
     fn k_shear(&mut self, i: usize, j: usize, s: f64);
     fn k_scale(&mut self, i: usize, c: f64);
     fn k_rotate(&mut self, i: usize, j: usize, c: f64, s: f64);
