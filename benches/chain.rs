@@ -11,7 +11,8 @@
 //!   baseline; operators built per ray and applied checked; the same recorded on a
 //!   reused `Tape` and run. Fixed parameters: the baseline with coefficients computed
 //!   once; the public `Chain::apply` (compiled tape); `Chain::eval_batch` on one core
-//!   and on every core. Per-ray parameters, batched: `eval_batch_with` building and
+//!   and on every core; `Chain::eval_lanes` on the same states stored
+//!   structure-of-arrays ([`CovLanes`]). Per-ray parameters, batched: `eval_batch_with` building and
 //!   applying each state's operators, on one core and on every core, next to the
 //!   per-ray baseline over the same 4,096 states.
 
@@ -24,7 +25,7 @@ use covtrace::curvature::Curvature;
 use covtrace::occlusion::Window;
 use covtrace::projection::{Mirror, Project, RotateFrame, Unproject};
 use covtrace::travel::Travel;
-use covtrace::{Chain, Cov, CovFactor, Form, Operator, Spectrum, Tape};
+use covtrace::{Chain, Cov, CovFactor, CovLanes, Form, Operator, Spectrum, Tape};
 use criterion::{BatchSize, Bencher, Criterion, Throughput, criterion_group, criterion_main};
 use glam::DVec3;
 use rand::{Rng, SeedableRng};
@@ -354,6 +355,25 @@ fn bounce_n<const N: usize>(c: &mut Criterion, rng: &mut ChaCha8Rng) {
                 batch(b, p, &|s| chain.eval_batch(form, s).len())
             });
         }
+    }
+    // The same states stored structure-of-arrays: the batch without its transpositions.
+    let many_lanes: CovLanes<N> = many.iter().copied().collect();
+    for (threads, p) in &pools {
+        g.bench_function(format!("fixed: Chain::eval_lanes (covariance, {threads})"), |b| {
+            b.iter_custom(|iters| {
+                p.install(|| {
+                    let mut total = Duration::ZERO;
+                    for _ in 0..iters {
+                        let mut states = many_lanes.clone();
+                        let t = Instant::now();
+                        black_box(chain.eval_lanes(&mut states).len());
+                        total += t.elapsed();
+                        black_box(&states);
+                    }
+                    total
+                })
+            })
+        });
     }
     // Per-ray parameters, batched: each state's operators built and applied in parallel.
     for (name, form) in [
