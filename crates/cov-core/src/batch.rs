@@ -8,7 +8,8 @@
 //! baseline target and chosen at run time. Every lane computes exactly what the scalar
 //! kernels compute (same operations in the same order, no fused multiply-add), so a
 //! covariance batch gives the same bits as [`Chain::eval_in`]. A square-root batch runs
-//! the chain's compiled program state by state.
+//! the chain's compiled program state by state. States kept structure-of-arrays
+//! ([`crate::CovLanes`], [`Chain::eval_lanes`]) skip the transposition in and out.
 
 use rayon::prelude::*;
 

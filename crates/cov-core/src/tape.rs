@@ -3,7 +3,9 @@
 //! when it is recorded. Running it is the fast path of [`crate::Chain`]: no parameter
 //! validation, no axis lookup, no `Result` and no finiteness check per kernel, no dynamic
 //! dispatch, and no copy of Σ per step. Finiteness is checked where a later kernel could
-//! hide an ∞ (before a lobe, which may zero a row) and once at the end; a run that fails
+//! hide an ∞ (before a window or a multi-axis lobe, and in square-root form before every
+//! lobe; the covariance form's one-axis lobe snaps a row to `v − v`, which keeps an ∞
+//! visible) and once at the end; a run that fails
 //! is repeated in checked mode by the caller, which finds and reports the failing step
 //! exactly as before.
 //!
@@ -779,7 +781,9 @@ pub(crate) fn concrete_factor<const N: usize>(f: &mut CovFactor<N>) -> crate::Co
 /// form, and each state of [`crate::eval_batch_with`]). Operators validate their
 /// parameters and resolve their axes as usual; the kernels then run without a check or
 /// a commit per call, and finiteness is checked where a kernel could hide an ∞ (before
-/// a lobe or a window) and, by the caller, at the end. Any error here only means "not
+/// a window or a multi-axis lobe, and before a one-axis lobe unless the form's snap
+/// keeps an ∞ visible, `Kernels::LOBE_1_KEEPS_NON_FINITE`) and, by the caller, at the
+/// end. Any error here only means "not
 /// clean": the caller re-runs the operators in checked mode from the start, which
 /// reports the failing step exactly.
 #[derive(Debug)]
