@@ -199,6 +199,29 @@ fn packs<const N: usize>(covs: &[Cov<N>]) -> Vec<Packed<N>> {
     covs.iter().map(packed).collect()
 }
 
+/// Times `run` on a fresh copy of `input` inside `pool` (the copy outside the timing, a
+/// whole sample per `install`: what is timed is the batch, not handing it to a thread).
+fn in_pool<T: Clone + Sync>(
+    b: &mut Bencher<'_>,
+    pool: &rayon::ThreadPool,
+    input: &T,
+    run: &(dyn Fn(&mut T) -> usize + Sync),
+) {
+    b.iter_custom(|iters| {
+        pool.install(|| {
+            let mut total = Duration::ZERO;
+            for _ in 0..iters {
+                let mut states = input.clone();
+                let t = Instant::now();
+                black_box(run(&mut states));
+                total += t.elapsed();
+                black_box(&states);
+            }
+            total
+        })
+    })
+}
+
 fn ops(c: &mut Criterion, rng: &mut ChaCha8Rng) {
     let covs = random_covs::<4>(rng);
     let facs: Vec<CovFactor<4>> = covs.iter().map(CovFactor::from_cov).collect();
@@ -331,20 +354,8 @@ fn bounce_n<const N: usize>(c: &mut Criterion, rng: &mut ChaCha8Rng) {
     };
     let pools = [("1 thread", pool(1)), ("all threads", pool(0))];
     let batch =
-        |b: &mut Bencher<'_>, pool: &rayon::ThreadPool, run: &(dyn Fn(&mut [Cov<N>]) -> usize + Sync)| {
-            b.iter_custom(|iters| {
-                pool.install(|| {
-                    let mut total = Duration::ZERO;
-                    for _ in 0..iters {
-                        let mut states = many.clone();
-                        let t = Instant::now();
-                        black_box(run(&mut states));
-                        total += t.elapsed();
-                        black_box(&states);
-                    }
-                    total
-                })
-            })
+        |b: &mut Bencher<'_>, pool: &rayon::ThreadPool, run: &(dyn Fn(&mut Vec<Cov<N>>) -> usize + Sync)| {
+            in_pool(b, pool, &many, run)
         };
     for (name, form) in [
         ("covariance", Form::Covariance),
@@ -360,19 +371,7 @@ fn bounce_n<const N: usize>(c: &mut Criterion, rng: &mut ChaCha8Rng) {
     let many_lanes: CovLanes<N> = many.iter().copied().collect();
     for (threads, p) in &pools {
         g.bench_function(format!("fixed: Chain::eval_lanes (covariance, {threads})"), |b| {
-            b.iter_custom(|iters| {
-                p.install(|| {
-                    let mut total = Duration::ZERO;
-                    for _ in 0..iters {
-                        let mut states = many_lanes.clone();
-                        let t = Instant::now();
-                        black_box(chain.eval_lanes(&mut states).len());
-                        total += t.elapsed();
-                        black_box(&states);
-                    }
-                    total
-                })
-            })
+            in_pool(b, p, &many_lanes, &|s| chain.eval_lanes(s).len())
         });
     }
     // Per-ray parameters, batched: each state's operators built and applied in parallel.
