@@ -327,13 +327,11 @@ pub(crate) fn run_groups<const N: usize>(prog: &[LaneOp], groups: &mut [Lane], p
         run_group::<N>(prog, a);
         let mut bad = [false; LANES];
         mark_non_finite::<N>(a, &mut bad);
-        if bad.contains(&true) {
-            for (l, _) in bad.iter().enumerate().filter(|(_, b)| **b) {
-                for (e, saved) in a.iter_mut().zip(&backup) {
-                    e[l] = saved[l];
-                }
-                poisoned.push(g * LANES + l);
+        for (l, _) in bad.iter().enumerate().filter(|(_, b)| **b) {
+            for (e, saved) in a.iter_mut().zip(&backup) {
+                e[l] = saved[l];
             }
+            poisoned.push(g * LANES + l);
         }
     }
 }

@@ -80,7 +80,7 @@ impl<const N: usize> CovLanes<N> {
             self.data.resize(self.data.len() + Self::P, [0.0; LANES]);
         }
         self.len += 1;
-        self.write(self.len - 1, &c);
+        write(&mut self.data, self.len - 1, &c);
     }
 
     /// State `i`, or `None` past the end.
@@ -98,7 +98,7 @@ impl<const N: usize> CovLanes<N> {
             "CovLanes::set: index {i} past the end ({} states)",
             self.len
         );
-        self.write(i, &c);
+        write(&mut self.data, i, &c);
     }
 
     /// The states in order, as [`Cov`] values.
@@ -109,10 +109,6 @@ impl<const N: usize> CovLanes<N> {
     /// The states as a `Vec` of [`Cov`].
     pub fn to_vec(&self) -> Vec<Cov<N>> {
         self.iter().collect()
-    }
-
-    fn write(&mut self, i: usize, c: &Cov<N>) {
-        write(&mut self.data, i, c);
     }
 }
 
@@ -206,29 +202,23 @@ impl Chain {
                 let base = c * CHUNK;
                 let in_chunk = len.saturating_sub(base).min(CHUNK);
                 let mut bad = Vec::new();
-                // A state the fast path refused, restored: the checked path decides.
-                let retry = |chunk: &mut [Lane], k: usize, bad: &mut Vec<(usize, CovError)>| {
-                    let mut s = read::<N>(chunk, k);
-                    self.report_failure(Form::Covariance, &mut s, base + k, bad);
-                    write(chunk, k, &s);
-                };
                 match &prog {
                     Some(prog) => {
                         let mut poisoned = Vec::new();
                         run_groups::<N>(prog, chunk, &mut poisoned);
-                        // Spare lanes of the last group are not states.
+                        // A lane the program refused is restored: the checked path
+                        // decides. Spare lanes of the last group are not states.
                         for k in poisoned.into_iter().filter(|&k| k < in_chunk) {
-                            retry(chunk, k, &mut bad);
+                            let mut s = read::<N>(chunk, k);
+                            self.report_failure(Form::Covariance, &mut s, base + k, &mut bad);
+                            write(chunk, k, &s);
                         }
                     }
                     None => {
                         for k in 0..in_chunk {
                             let mut s = read::<N>(chunk, k);
-                            if tape.run(&mut s) {
-                                write(chunk, k, &s);
-                            } else {
-                                retry(chunk, k, &mut bad);
-                            }
+                            self.run_one(tape, Form::Covariance, &mut s, base + k, &mut bad);
+                            write(chunk, k, &s);
                         }
                     }
                 }
