@@ -4,11 +4,14 @@
 //!
 //! - `chain/op/N=4`: each operator of the bounce chain, built per ray and applied to
 //!   `Cov<4>` and `CovFactor<4>` (checked: parameters, axes, overflow), next to the
-//!   baseline's update.
+//!   baseline's update: through `Operator::apply` (`&mut dyn Spectrum`, as a chain or
+//!   plugin calls it) and through the operator's typed body (`apply_to`, the spectrum's
+//!   type known at the call: "typed").
 //! - `chain/bounce/N=2|4|5`: the 10-operator bounce chain (travel, projection from
 //!   vectors, curvature, mirror, Phong lobe, curvature back, unprojection, rotation,
 //!   travel, window; at N = 2 the rotations are identities). Per-ray parameters: the
-//!   baseline; operators built per ray and applied checked; the same recorded on a
+//!   baseline; operators built per ray and applied checked, through `Operator::apply`
+//!   and through their typed bodies; the same recorded on a
 //!   reused `Tape` and run. Fixed parameters: the baseline with coefficients computed
 //!   once; the public `Chain::apply` (compiled tape); `Chain::eval_batch` on one core
 //!   and on every core; `Chain::eval_lanes` on the same states stored
@@ -133,6 +136,27 @@ impl Ops {
         self.list().into_iter().flatten().all(|op| op.apply(s).is_ok())
     }
 
+    /// The same operators through their typed bodies (`apply_to`): the spectrum's type
+    /// is known here, so the kernels inline with constant indices.
+    #[inline(always)]
+    fn apply_typed<S: Spectrum>(&self, s: &mut S) -> bool {
+        let mut run = || -> Result<(), covtrace::CovError> {
+            self.t1.apply_to(s)?;
+            self.project.apply_to(s)?;
+            self.k.apply_to(s)?;
+            Mirror.apply_to(s)?;
+            self.lobe.apply_to(s)?;
+            self.k_back.apply_to(s)?;
+            self.unproject.apply_to(s)?;
+            if let Some(t) = &self.turn {
+                t.apply_to(s)?;
+            }
+            self.t2.apply_to(s)?;
+            self.window.apply_to(s)
+        };
+        run().is_ok()
+    }
+
     fn chain(&self) -> Chain {
         let mut c = Chain::new();
         c.push(self.t1);
@@ -249,6 +273,18 @@ fn ops(c: &mut Criterion, rng: &mut ChaCha8Rng) {
                     let _ = black_box($lib.apply(x));
                 })
             });
+            g.bench_function(concat!($name, ": Cov<4> typed"), |b| {
+                each(b, &covs, |i, x| {
+                    let $rr = &rays[i];
+                    let _ = black_box($lib.apply_to(x));
+                })
+            });
+            g.bench_function(concat!($name, ": CovFactor<4> typed"), |b| {
+                each(b, &facs, |i, x| {
+                    let $rr = &rays[i];
+                    let _ = black_box($lib.apply_to(x));
+                })
+            });
         };
     }
     op!("travel", |p, r| p.travel(r.d1), |r| Travel::new(r.d1).expect("d"));
@@ -304,6 +340,16 @@ fn bounce_n<const N: usize>(c: &mut Criterion, rng: &mut ChaCha8Rng) {
     g.bench_function("per-ray: operators applied (square root)", |b| {
         each(b, &facs, |i, x| {
             black_box(Ops::new(&rays[i], N).apply(x));
+        })
+    });
+    g.bench_function("per-ray: operators typed (covariance)", |b| {
+        each(b, &covs, |i, x| {
+            black_box(Ops::new(&rays[i], N).apply_typed(x));
+        })
+    });
+    g.bench_function("per-ray: operators typed (square root)", |b| {
+        each(b, &facs, |i, x| {
+            black_box(Ops::new(&rays[i], N).apply_typed(x));
         })
     });
     for (name, form) in [

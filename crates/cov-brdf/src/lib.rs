@@ -88,7 +88,7 @@
 
 pub mod spec;
 
-use cov_core::{CovError, FOUR_PI_SQ, Operator, Spectrum};
+use cov_core::{Axis, CovError, FOUR_PI_SQ, Operator, Spectrum};
 use cov_curvature::Curvature;
 use cov_projection::{Mirror, Project, Unproject};
 
@@ -168,6 +168,7 @@ impl Lobe {
     ///
     /// # Errors
     /// Negative or non-finite parameters.
+    #[inline(always)]
     pub fn validated(self) -> Result<Lobe, CovError> {
         let params: [(&str, &str, f64); 2] = match self {
             Lobe::Diffuse | Lobe::Mirror => return Ok(self),
@@ -186,6 +187,7 @@ impl Lobe {
 
     /// Primal variance of the lobe along `u` and `v` (tangent units²): 0 for a mirror,
     /// infinite for diffuse.
+    #[inline(always)]
     pub fn variances(&self) -> (f64, f64) {
         match *self {
             Lobe::Diffuse => (f64::INFINITY, f64::INFINITY),
@@ -209,20 +211,29 @@ impl Lobe {
     ///
     /// # Errors
     /// Overflow.
-    pub fn apply_to(&self, cov: &mut dyn Spectrum) -> Result<(), CovError> {
+    #[inline]
+    pub fn apply_to<S: Spectrum + ?Sized>(&self, cov: &mut S) -> Result<(), CovError> {
         let (vu, vv) = self.variances();
-        let dirs = cov.direction_axes();
-        for (&axis, var) in dirs.iter().zip([vu, vv]) {
-            if var == 0.0 {
-                continue;
-            }
-            // S = 1/(4π² var): 0 for a diffuse lobe; a tiny var gives a large finite S.
-            let s = 1.0 / (FOUR_PI_SQ * var);
-            let s = if s.is_finite() { s } else { f64::MAX };
-            cov.convolve(&[axis], &[s])?;
+        // Written out per axis (not a loop over `direction_axes`), so that a caller that
+        // knows its spectrum type gets each lobe with a constant axis.
+        lobe_on(cov, Axis::U, vu)?;
+        if cov.has(Axis::V) {
+            lobe_on(cov, Axis::V, vv)?;
         }
         Ok(())
     }
+}
+
+/// The lobe of primal variance `var` on direction axis `axis`: skipped for 0 (a mirror).
+#[inline(always)]
+fn lobe_on<S: Spectrum + ?Sized>(cov: &mut S, axis: Axis, var: f64) -> Result<(), CovError> {
+    if var == 0.0 {
+        return Ok(());
+    }
+    // S = 1/(4π² var): 0 for a diffuse lobe; a tiny var gives a large finite S.
+    let s = 1.0 / (FOUR_PI_SQ * var);
+    let s = if s.is_finite() { s } else { f64::MAX };
+    cov.convolve(&[axis], &[s])
 }
 
 /// A lobe applied on its own (e.g. a phase function or a rough transmission).
@@ -237,6 +248,7 @@ impl Brdf {
 
     /// # Errors
     /// Invalid lobe parameters.
+    #[inline]
     pub fn new(lobe: Lobe) -> Result<Self, CovError> {
         Ok(Brdf {
             lobe: lobe.validated()?,
@@ -249,9 +261,22 @@ impl Brdf {
     }
 }
 
+impl Brdf {
+    /// [`Operator::apply`] with the spectrum's type known where it is called: on a
+    /// concrete `Cov<N>` or `CovFactor<N>` the kernels inline with constant indices (no
+    /// dynamic dispatch); `&mut dyn Spectrum` works too. The same result bits either way.
+    ///
+    /// # Errors
+    /// As [`Operator::apply`].
+    #[inline]
+    pub fn apply_to<S: Spectrum + ?Sized>(&self, cov: &mut S) -> Result<(), CovError> {
+        self.lobe.apply_to(cov)
+    }
+}
+
 impl Operator for Brdf {
     fn apply(&self, cov: &mut dyn Spectrum) -> Result<(), CovError> {
-        self.lobe.apply_to(cov)
+        self.apply_to(cov)
     }
 }
 

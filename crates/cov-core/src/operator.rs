@@ -20,6 +20,14 @@ use crate::{
 /// name and the required axes to flatland (`x, u`). The trait is object safe: chains hold
 /// `Arc<dyn Operator>`.
 ///
+/// **Typed bodies.** Through `dyn Spectrum` every kernel call is a dynamic call that
+/// resolves its axes at run time. An operator can write its body once as a generic
+/// method, `fn apply_to<S: Spectrum + ?Sized>(&self, s: &mut S)`, and implement
+/// `apply` as `self.apply_to(s)`: a caller that holds a concrete `Cov<N>` or
+/// `CovFactor<N>` then gets the kernels inlined with constant indices, with the same
+/// checks and the same bits. The bundled operators of the bounce chain (travel,
+/// curvature, projection, mirror, frame rotation, BRDF lobe, window) do this.
+///
 /// ```
 /// use cov_core::{Axis, Cov, CovError, CovFactor, Operator, Spectrum};
 ///

@@ -212,7 +212,7 @@ pub trait Spectrum: fmt::Debug {
     ///
     /// # Errors
     /// Missing axis, `target == source`, non-finite `s`, or an overflowing result.
-    #[inline]
+    #[inline(always)]
     fn shear(&mut self, target: Axis, source: Axis, s: f64) -> Result<(), CovError> {
         CovError::require_finite("shear", "s", s)?;
         let (i, j) = two_axes(self.dim(), "shear", target, source)?;
@@ -227,7 +227,7 @@ pub trait Spectrum: fmt::Debug {
     ///
     /// # Errors
     /// Missing axis, non-finite `c`, or an overflowing result.
-    #[inline]
+    #[inline(always)]
     fn scale(&mut self, axis: Axis, c: f64) -> Result<(), CovError> {
         CovError::require_finite("scale", "c", c)?;
         let i = self.index(axis)?;
@@ -239,7 +239,7 @@ pub trait Spectrum: fmt::Debug {
     ///
     /// # Errors
     /// Missing axis, `a == b`, non-finite `angle`.
-    #[inline]
+    #[inline(always)]
     fn rotate(&mut self, a: Axis, b: Axis, angle: f64) -> Result<(), CovError> {
         CovError::require_finite("rotate", "angle", angle)?;
         let (i, j) = two_axes(self.dim(), "rotate", a, b)?;
@@ -252,6 +252,7 @@ pub trait Spectrum: fmt::Debug {
     ///
     /// # Errors
     /// [`CovError::MissingAxis`] in flatland (N = 2, 3); non-finite `angle`.
+    #[inline(always)]
     fn rotate_frame(&mut self, angle: f64) -> Result<(), CovError> {
         CovError::require_finite("rotate_frame", "angle", angle)?;
         let (x, y, u, v) = (
@@ -269,7 +270,7 @@ pub trait Spectrum: fmt::Debug {
     ///
     /// # Errors
     /// Missing axis, `w` negative or non-finite, overflow.
-    #[inline]
+    #[inline(always)]
     fn add_variance(&mut self, axis: Axis, w: f64) -> Result<(), CovError> {
         CovError::require_non_negative("add_variance", "w", w)?;
         let i = self.index(axis)?;
@@ -301,7 +302,7 @@ pub trait Spectrum: fmt::Debug {
     ///
     /// # Errors
     /// Missing or repeated axis, wrong size, `S` not finite/symmetric/PSD; overflow.
-    #[inline]
+    #[inline(always)]
     fn convolve(&mut self, axes: &[Axis], s: &[f64]) -> Result<(), CovError> {
         if let ([axis], [s1]) = (axes, s) {
             // One axis: S is a non-negative number; no eigen-check needed.
@@ -309,9 +310,7 @@ pub trait Spectrum: fmt::Debug {
             CovError::require_non_negative("convolve", "S", *s1)?;
             return self.raw_lobe_1("convolve", p, *s1);
         }
-        let (idx, k) = resolve(self.dim(), "convolve", axes)?;
-        let sm = block_from_slice("convolve", "S", k, s)?;
-        self.raw_lobe("convolve", &idx[..k], &sm)
+        convolve_block(self, axes, s)
     }
 
     /// Rule 4, in place: integration of the primal over `axes` (lens, shutter, sensor
@@ -322,15 +321,30 @@ pub trait Spectrum: fmt::Debug {
     ///
     /// # Errors
     /// Missing or repeated axis.
-    #[inline]
+    #[inline(always)]
     fn integrate(&mut self, axes: &[Axis]) -> Result<(), CovError> {
         if let [axis] = axes {
             let p = self.index(*axis)?;
             return self.raw_lobe_1("integrate", p, 0.0);
         }
-        let (idx, k) = resolve(self.dim(), "integrate", axes)?;
-        self.raw_lobe("integrate", &idx[..k], &[[0.0; MAX]; MAX])
+        integrate_block(self, axes)
     }
+}
+
+/// [`Spectrum::convolve`] on several axes: checked and run out of line, so that the
+/// one-axis case inlines into a caller that knows its spectrum type.
+#[inline(never)]
+fn convolve_block<S: Spectrum + ?Sized>(spec: &mut S, axes: &[Axis], s: &[f64]) -> Result<(), CovError> {
+    let (idx, k) = resolve(spec.dim(), "convolve", axes)?;
+    let sm = block_from_slice("convolve", "S", k, s)?;
+    spec.raw_lobe("convolve", &idx[..k], &sm)
+}
+
+/// [`Spectrum::integrate`] on several axes, out of line as [`convolve_block`].
+#[inline(never)]
+fn integrate_block<S: Spectrum + ?Sized>(spec: &mut S, axes: &[Axis]) -> Result<(), CovError> {
+    let (idx, k) = resolve(spec.dim(), "integrate", axes)?;
+    spec.raw_lobe("integrate", &idx[..k], &[[0.0; MAX]; MAX])
 }
 
 /// What a `&mut dyn Spectrum` holds ([`Spectrum::concrete`]): one of the two forms in one

@@ -76,6 +76,7 @@ impl Curvature {
     ///
     /// # Errors
     /// Non-finite `k`.
+    #[inline]
     pub fn isotropic(k: f64) -> Result<Self, CovError> {
         Self::anisotropic(k, k, 0.0)
     }
@@ -85,6 +86,7 @@ impl Curvature {
     ///
     /// # Errors
     /// Non-finite parameters.
+    #[inline]
     pub fn anisotropic(kx: f64, ky: f64, angle: f64) -> Result<Self, CovError> {
         Ok(Curvature {
             kx: CovError::require_finite(Self::NAME, "kx", kx)?,
@@ -150,24 +152,45 @@ impl Curvature {
         cov.shear(Axis::V, Axis::Y, sign * cos * kyy)
     }
 
+    #[inline]
     fn is_isotropic(&self) -> bool {
         self.kx == self.ky
     }
 }
 
-impl Operator for Curvature {
-    fn apply(&self, cov: &mut dyn Spectrum) -> Result<(), CovError> {
+impl Curvature {
+    /// [`Operator::apply`] with the spectrum's type known where it is called: on a
+    /// concrete `Cov<N>` or `CovFactor<N>` the kernels inline with constant indices (no
+    /// dynamic dispatch); `&mut dyn Spectrum` works too. The same result bits either way.
+    ///
+    /// # Errors
+    /// As [`Operator::apply`].
+    #[inline]
+    pub fn apply_to<S: Spectrum + ?Sized>(&self, cov: &mut S) -> Result<(), CovError> {
         if self.is_isotropic() {
             for &(p, d) in cov.transverse_pairs() {
                 cov.shear(d, p, self.kx)?;
             }
             return Ok(());
         }
+        self.apply_principal(cov)
+    }
+
+    /// The anisotropic case of [`Curvature::apply_to`], out of line so that the common
+    /// isotropic case stays small enough to inline.
+    #[inline(never)]
+    fn apply_principal<S: Spectrum + ?Sized>(&self, cov: &mut S) -> Result<(), CovError> {
         // Principal frame: rotate, shear each pair by its curvature, rotate back.
         cov.rotate_frame(self.angle)?;
         cov.shear(Axis::U, Axis::X, self.kx)?;
         cov.shear(Axis::V, Axis::Y, self.ky)?;
         cov.rotate_frame(-self.angle)
+    }
+}
+
+impl Operator for Curvature {
+    fn apply(&self, cov: &mut dyn Spectrum) -> Result<(), CovError> {
+        self.apply_to(cov)
     }
     fn requires(&self) -> AxisSet {
         if self.is_isotropic() {
@@ -191,6 +214,7 @@ impl CurvatureTensor {
 
     /// # Errors
     /// Non-finite entries.
+    #[inline]
     pub fn new(kxx: f64, kxy: f64, kyy: f64) -> Result<Self, CovError> {
         Ok(CurvatureTensor {
             k: [
@@ -202,8 +226,15 @@ impl CurvatureTensor {
     }
 }
 
-impl Operator for CurvatureTensor {
-    fn apply(&self, cov: &mut dyn Spectrum) -> Result<(), CovError> {
+impl CurvatureTensor {
+    /// [`Operator::apply`] with the spectrum's type known where it is called: on a
+    /// concrete `Cov<N>` or `CovFactor<N>` the kernels inline with constant indices (no
+    /// dynamic dispatch); `&mut dyn Spectrum` works too. The same result bits either way.
+    ///
+    /// # Errors
+    /// As [`Operator::apply`].
+    #[inline]
+    pub fn apply_to<S: Spectrum + ?Sized>(&self, cov: &mut S) -> Result<(), CovError> {
         let [kxx, kxy, kyy] = self.k;
         cov.shear(Axis::U, Axis::X, kxx)?;
         if cov.has(Axis::Y) {
@@ -218,6 +249,12 @@ impl Operator for CurvatureTensor {
             });
         }
         Ok(())
+    }
+}
+
+impl Operator for CurvatureTensor {
+    fn apply(&self, cov: &mut dyn Spectrum) -> Result<(), CovError> {
+        self.apply_to(cov)
     }
     fn requires(&self) -> AxisSet {
         if self.k[1] != 0.0 || self.k[2] != 0.0 {

@@ -66,6 +66,7 @@ pub mod spec;
 
 use cov_core::{Axis, CovError, FOUR_PI_SQ, Operator, Spectrum};
 
+#[inline]
 fn window_var(op: &str, name: &str, std: f64) -> Result<f64, CovError> {
     CovError::require_positive(op, name, std)?;
     let w = 1.0 / (FOUR_PI_SQ * std * std);
@@ -100,6 +101,7 @@ impl Window {
     ///
     /// # Errors
     /// Non-finite or non-positive std, or one so small the spectrum overflows.
+    #[inline]
     pub fn new(std_x: f64, std_y: f64) -> Result<Self, CovError> {
         Ok(Window {
             wx: window_var(Self::NAME, "std_x", std_x)?,
@@ -111,18 +113,32 @@ impl Window {
     ///
     /// # Errors
     /// As [`Window::new`].
+    #[inline]
     pub fn isotropic(std: f64) -> Result<Self, CovError> {
         Self::new(std, std)
     }
 }
 
-impl Operator for Window {
-    fn apply(&self, cov: &mut dyn Spectrum) -> Result<(), CovError> {
+impl Window {
+    /// [`Operator::apply`] with the spectrum's type known where it is called: on a
+    /// concrete `Cov<N>` or `CovFactor<N>` the kernels inline with constant indices (no
+    /// dynamic dispatch); `&mut dyn Spectrum` works too. The same result bits either way.
+    ///
+    /// # Errors
+    /// As [`Operator::apply`].
+    #[inline]
+    pub fn apply_to<S: Spectrum + ?Sized>(&self, cov: &mut S) -> Result<(), CovError> {
         cov.add_variance(Axis::X, self.wx)?;
         if cov.has(Axis::Y) {
             cov.add_variance(Axis::Y, self.wy)?;
         }
         Ok(())
+    }
+}
+
+impl Operator for Window {
+    fn apply(&self, cov: &mut dyn Spectrum) -> Result<(), CovError> {
+        self.apply_to(cov)
     }
 }
 

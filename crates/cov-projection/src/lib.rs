@@ -66,11 +66,13 @@ pub mod spec;
 use cov_core::{Axis, AxisSet, CovError, Operator, Spectrum};
 use glam::DVec3;
 
+#[inline]
 fn check_cos(op: &str, c: f64) -> Result<f64, CovError> {
     CovError::require_range(op, "cos", c, |c| c > 0.0 && c <= 1.0, "must be in (0, 1]")
 }
 
-fn rotate(cov: &mut dyn Spectrum, angle: f64) -> Result<(), CovError> {
+#[inline(always)]
+fn rotate<S: Spectrum + ?Sized>(cov: &mut S, angle: f64) -> Result<(), CovError> {
     if angle != 0.0 {
         cov.rotate_frame(angle)
     } else {
@@ -101,6 +103,7 @@ impl Project {
     ///
     /// # Errors
     /// `cos` not in (0, 1].
+    #[inline]
     pub fn new(cos: f64) -> Result<Self, CovError> {
         Self::with_angle(cos, 0.0)
     }
@@ -109,6 +112,7 @@ impl Project {
     ///
     /// # Errors
     /// `cos` not in (0, 1], non-finite `angle`.
+    #[inline]
     pub fn with_angle(cos: f64, angle: f64) -> Result<Self, CovError> {
         Ok(Project {
             cos: check_cos(Self::NAME, cos)?,
@@ -165,10 +169,23 @@ impl Project {
     }
 }
 
-impl Operator for Project {
-    fn apply(&self, cov: &mut dyn Spectrum) -> Result<(), CovError> {
+impl Project {
+    /// [`Operator::apply`] with the spectrum's type known where it is called: on a
+    /// concrete `Cov<N>` or `CovFactor<N>` the kernels inline with constant indices (no
+    /// dynamic dispatch); `&mut dyn Spectrum` works too. The same result bits either way.
+    ///
+    /// # Errors
+    /// As [`Operator::apply`].
+    #[inline]
+    pub fn apply_to<S: Spectrum + ?Sized>(&self, cov: &mut S) -> Result<(), CovError> {
         rotate(cov, self.angle)?;
         cov.scale(Axis::X, self.cos)
+    }
+}
+
+impl Operator for Project {
+    fn apply(&self, cov: &mut dyn Spectrum) -> Result<(), CovError> {
+        self.apply_to(cov)
     }
     fn requires(&self) -> AxisSet {
         needs(self.angle)
@@ -193,6 +210,7 @@ impl Unproject {
 
     /// # Errors
     /// `cos` not in (0, 1].
+    #[inline]
     pub fn new(cos: f64) -> Result<Self, CovError> {
         Self::with_angle(cos, 0.0)
     }
@@ -201,6 +219,7 @@ impl Unproject {
     ///
     /// # Errors
     /// `cos` not in (0, 1], non-finite `angle`.
+    #[inline]
     pub fn with_angle(cos: f64, angle: f64) -> Result<Self, CovError> {
         Ok(Unproject {
             cos: check_cos(Self::NAME, cos)?,
@@ -209,10 +228,23 @@ impl Unproject {
     }
 }
 
-impl Operator for Unproject {
-    fn apply(&self, cov: &mut dyn Spectrum) -> Result<(), CovError> {
+impl Unproject {
+    /// [`Operator::apply`] with the spectrum's type known where it is called: on a
+    /// concrete `Cov<N>` or `CovFactor<N>` the kernels inline with constant indices (no
+    /// dynamic dispatch); `&mut dyn Spectrum` works too. The same result bits either way.
+    ///
+    /// # Errors
+    /// As [`Operator::apply`].
+    #[inline]
+    pub fn apply_to<S: Spectrum + ?Sized>(&self, cov: &mut S) -> Result<(), CovError> {
         cov.scale(Axis::X, 1.0 / self.cos)?;
         rotate(cov, self.angle)
+    }
+}
+
+impl Operator for Unproject {
+    fn apply(&self, cov: &mut dyn Spectrum) -> Result<(), CovError> {
+        self.apply_to(cov)
     }
     fn requires(&self) -> AxisSet {
         needs(self.angle)
@@ -228,12 +260,27 @@ impl Mirror {
     pub const NAME: &'static str = "Mirror";
 }
 
-impl Operator for Mirror {
-    fn apply(&self, cov: &mut dyn Spectrum) -> Result<(), CovError> {
-        for &a in cov.direction_axes() {
-            cov.scale(a, -1.0)?;
+impl Mirror {
+    /// [`Operator::apply`] with the spectrum's type known where it is called: on a
+    /// concrete `Cov<N>` or `CovFactor<N>` the kernels inline with constant indices (no
+    /// dynamic dispatch); `&mut dyn Spectrum` works too. The same result bits either way.
+    ///
+    /// # Errors
+    /// As [`Operator::apply`].
+    #[inline]
+    pub fn apply_to<S: Spectrum + ?Sized>(&self, cov: &mut S) -> Result<(), CovError> {
+        // Per axis, not a loop over `direction_axes`: constant axes for a known type.
+        cov.scale(Axis::U, -1.0)?;
+        if cov.has(Axis::V) {
+            cov.scale(Axis::V, -1.0)?;
         }
         Ok(())
+    }
+}
+
+impl Operator for Mirror {
+    fn apply(&self, cov: &mut dyn Spectrum) -> Result<(), CovError> {
+        self.apply_to(cov)
     }
 }
 
@@ -249,6 +296,7 @@ impl RotateFrame {
 
     /// # Errors
     /// Non-finite `angle`.
+    #[inline]
     pub fn new(angle: f64) -> Result<Self, CovError> {
         Ok(RotateFrame {
             angle: CovError::require_finite(Self::NAME, "angle", angle)?,
@@ -256,9 +304,22 @@ impl RotateFrame {
     }
 }
 
+impl RotateFrame {
+    /// [`Operator::apply`] with the spectrum's type known where it is called: on a
+    /// concrete `Cov<N>` or `CovFactor<N>` the kernels inline with constant indices (no
+    /// dynamic dispatch); `&mut dyn Spectrum` works too. The same result bits either way.
+    ///
+    /// # Errors
+    /// As [`Operator::apply`].
+    #[inline]
+    pub fn apply_to<S: Spectrum + ?Sized>(&self, cov: &mut S) -> Result<(), CovError> {
+        cov.rotate_frame(self.angle)
+    }
+}
+
 impl Operator for RotateFrame {
     fn apply(&self, cov: &mut dyn Spectrum) -> Result<(), CovError> {
-        cov.rotate_frame(self.angle)
+        self.apply_to(cov)
     }
     fn requires(&self) -> AxisSet {
         AxisSet::SPACE

@@ -440,12 +440,22 @@ impl<const N: usize> Cov<N> {
     }
 
     /// Checks the result of a kernel; on overflow restores the input and reports.
-    #[inline]
+    #[inline(always)]
     fn finish(&mut self, op: &str, old: Self) -> Result<(), CovError> {
-        if let Err(e) = self.check_finite(op) {
-            *self = old;
-            return Err(e);
+        // The branch-free test first (it vectorises); the search for the entry to report
+        // only on failure.
+        if self.all_finite() {
+            return Ok(());
         }
-        Ok(())
+        self.overflowed(op, old)
+    }
+
+    /// The error of [`Cov::finish`], with Σ restored to `old`.
+    #[cold]
+    #[inline(never)]
+    fn overflowed(&mut self, op: &str, old: Self) -> Result<(), CovError> {
+        let e = self.check_finite(op);
+        *self = old;
+        e
     }
 }
