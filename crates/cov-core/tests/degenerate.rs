@@ -167,3 +167,58 @@ fn chain_catches_a_misbehaving_operator() {
     assert!(Operator::apply(&chain, &mut c).is_err());
     assert_eq!(c, start, "chain restores Σ on error");
 }
+
+/// A denormal `Σ_uu` beside a huge `Σ_xx` (rank 1: `Σ_xu² = Σ_xx Σ_uu`): `Σ_xu / Σ_uu`
+/// overflows, and integrating `u` used to leave `Σ_xx` NaN with `Ok`. The update is well
+/// posed, `Σ_xx' = Σ_xx s / (s + Σ_uu)` (0 for integration): every path gives it.
+#[test]
+fn integration_over_a_denormal_axis_beside_a_huge_one() {
+    let m = SMatrix::<f64, 2, 2>::new(1e300, 1e-10, 1e-10, 1e-320);
+    let c = Cov::<2>::from_matrix(&m).expect("PSD");
+    for (what, s) in [
+        ("integrate", None),
+        ("convolve 1e-320", Some(1e-320)),
+        ("convolve 1", Some(1.0)),
+    ] {
+        let mut x = c;
+        match s {
+            None => x.integrate(&[Axis::U]),
+            Some(s) => x.convolve(&[Axis::U], &[s]),
+        }
+        .expect("well posed");
+        assert!(x.is_finite(), "{what}: {x:?}");
+        let s = s.unwrap_or(0.0);
+        let want = 1e300 * (s / (s + 1e-320));
+        // Σ_uu = 1e-320 is denormal: about 11 bits of precision.
+        assert!(
+            (x.get(0, 0) - want).abs() <= 1e-3 * want + 1e288,
+            "{what}: Σ_xx = {}, want {want}",
+            x.get(0, 0)
+        );
+        check_clean(x, what);
+    }
+    // The compiled chain and the batch lanes fall back to the checked kernel: the same.
+    let mut chain = Chain::new();
+    chain.push(IntegrateU);
+    for _ in 0..3 {
+        let mut x = c;
+        chain.apply(&mut x).expect("well posed");
+        assert!(x.is_finite() && x.get(0, 0).abs() <= 1e288, "{x:?}");
+    }
+    let mut many = vec![c; 70];
+    assert!(chain.eval_batch(cov_core::Form::Covariance, &mut many).is_empty());
+    let mut lanes: cov_core::CovLanes<2> = many.iter().copied().collect();
+    assert!(chain.eval_lanes(&mut lanes).is_empty());
+    for x in many.iter().chain(lanes.to_vec().iter()) {
+        assert!(x.is_finite() && x.get(0, 0).abs() <= 1e288, "{x:?}");
+    }
+}
+
+#[derive(Debug)]
+struct IntegrateU;
+
+impl Operator for IntegrateU {
+    fn apply(&self, s: &mut dyn Spectrum) -> Result<(), CovError> {
+        s.integrate(&[Axis::U])
+    }
+}

@@ -124,12 +124,8 @@ impl<const N: usize> Spectrum for Cov<N> {
 
     #[inline(always)]
     fn raw_lobe_1(&mut self, op: &str, p: usize, s: f64) -> Result<(), CovError> {
-        if s == 0.0 {
-            // Integration (or a diffuse lobe): a Schur complement of finite entries with a
-            // guarded division only shrinks Σ; nothing can overflow.
-            self.lobe_product_1(p, 0.0);
-            return Ok(());
-        }
+        // Checked for every `s`, integration too: a Schur complement of a PSD Σ shrinks
+        // it, but its rounding near f64's range is not bounded by that.
         let old = *self;
         self.lobe_product_1(p, s);
         self.finish(op, old)
@@ -385,10 +381,24 @@ impl<const N: usize> Cov<N> {
                 continue;
             }
             let ga = col[a] * inv;
-            for b in a..N {
-                if b != p {
-                    let v = self.get(a, b) - ga * col[b];
-                    self.set(a, b, v);
+            if ga.is_finite() {
+                for b in a..N {
+                    if b != p {
+                        let v = self.get(a, b) - ga * col[b];
+                        self.set(a, b, v);
+                    }
+                }
+            } else {
+                // `Σ_ap / m` overflows when `m` is tiny (a denormal `Σ_pp` beside a huge
+                // `Σ_aa`; `1/m` itself may be ∞). The product of the halves
+                // `(Σ_ap/√m)(Σ_bp/√m)` cannot: each is at most `√Σ_aa` for a PSD Σ.
+                let r = 1.0 / m.sqrt();
+                let ha = col[a] * r;
+                for b in a..N {
+                    if b != p {
+                        let v = self.get(a, b) - ha * (col[b] * r);
+                        self.set(a, b, v);
+                    }
                 }
             }
             self.set(a, p, col[a] * t);
