@@ -382,6 +382,9 @@ impl<const N: usize> Kernels for CovFactor<N> {
 }
 
 impl<const N: usize> CovFactor<N> {
+    /// Rotation of rows `i` and `j` by (cos, sin); inlined, so that the compiled program's
+    /// constant indices reach it (it was a call per plane: 6 per bounce chain).
+    #[inline(always)]
     fn rotate_rows(&mut self, i: usize, j: usize, c: f64, s: f64) {
         for k in 0..N {
             let (x, y) = (self.l[i][k], self.l[j][k]);
