@@ -16,8 +16,9 @@
 //!   once; the public `Chain::apply` (compiled tape); `Chain::eval_batch` on one core
 //!   and on every core; `Chain::eval_lanes` on the same states stored
 //!   structure-of-arrays ([`CovLanes`]). Per-ray parameters, batched: `eval_batch_with` building and
-//!   applying each state's operators, on one core and on every core, next to the
-//!   per-ray baseline over the same 4,096 states.
+//!   applying each state's operators, on one core and on every core, and
+//!   `eval_batch_typed` applying them through their typed bodies (`StateOps`), next to
+//!   the per-ray baseline over the same 4,096 states.
 
 use std::f64::consts::PI;
 use std::hint::black_box;
@@ -28,7 +29,7 @@ use covtrace::curvature::Curvature;
 use covtrace::occlusion::Window;
 use covtrace::projection::{Mirror, Project, RotateFrame, Unproject};
 use covtrace::travel::Travel;
-use covtrace::{Chain, Cov, CovFactor, CovLanes, Form, Operator, Spectrum, Tape};
+use covtrace::{Chain, Cov, CovError, CovFactor, CovLanes, Form, Operator, Spectrum, StateOps, Tape};
 use criterion::{BatchSize, Bencher, Criterion, Throughput, criterion_group, criterion_main};
 use glam::DVec3;
 use rand::{Rng, SeedableRng};
@@ -140,21 +141,24 @@ impl Ops {
     /// is known here, so the kernels inline with constant indices.
     #[inline(always)]
     fn apply_typed<S: Spectrum>(&self, s: &mut S) -> bool {
-        let mut run = || -> Result<(), covtrace::CovError> {
-            self.t1.apply_to(s)?;
-            self.project.apply_to(s)?;
-            self.k.apply_to(s)?;
-            Mirror.apply_to(s)?;
-            self.lobe.apply_to(s)?;
-            self.k_back.apply_to(s)?;
-            self.unproject.apply_to(s)?;
-            if let Some(t) = &self.turn {
-                t.apply_to(s)?;
-            }
-            self.t2.apply_to(s)?;
-            self.window.apply_to(s)
-        };
-        run().is_ok()
+        self.try_typed(s).is_ok()
+    }
+
+    /// [`Ops::apply_typed`] with the first error.
+    #[inline(always)]
+    fn try_typed<S: Spectrum>(&self, s: &mut S) -> Result<(), CovError> {
+        self.t1.apply_to(s)?;
+        self.project.apply_to(s)?;
+        self.k.apply_to(s)?;
+        Mirror.apply_to(s)?;
+        self.lobe.apply_to(s)?;
+        self.k_back.apply_to(s)?;
+        self.unproject.apply_to(s)?;
+        if let Some(t) = &self.turn {
+            t.apply_to(s)?;
+        }
+        self.t2.apply_to(s)?;
+        self.window.apply_to(s)
     }
 
     fn chain(&self) -> Chain {
@@ -172,6 +176,20 @@ impl Ops {
         c.push(self.t2);
         c.push(self.window);
         c
+    }
+}
+
+/// Each ray's operators, built per state and applied through their typed bodies: the
+/// per-state operators of `eval_batch_typed`.
+struct PerRay<'a> {
+    rays: &'a [Ray],
+    n: usize,
+}
+
+impl StateOps for PerRay<'_> {
+    #[inline(always)]
+    fn apply<S: Spectrum>(&self, i: usize, s: &mut S) -> Result<(), CovError> {
+        Ops::new(&self.rays[i % self.rays.len()], self.n).try_typed(s)
     }
 }
 
@@ -435,6 +453,12 @@ fn bounce_n<const N: usize>(c: &mut Criterion, rng: &mut ChaCha8Rng) {
         for (threads, p) in &pools {
             g.bench_function(format!("per-ray: eval_batch_with ({name}, {threads})"), |b| {
                 batch(b, p, &|s| covtrace::eval_batch_with(form, s, per_ray).len())
+            });
+        }
+        let typed = PerRay { rays: &rays, n: N };
+        for (threads, p) in &pools {
+            g.bench_function(format!("per-ray: eval_batch_typed ({name}, {threads})"), |b| {
+                batch(b, p, &|s| covtrace::eval_batch_typed(form, s, &typed).len())
             });
         }
     }

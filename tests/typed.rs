@@ -157,3 +157,71 @@ fn typed_bodies_report_the_same_errors() {
     // The factor holds √Σ: its rows reach 1e200 and stay finite.
     assert_eq!(both(CovFactor::from_cov(&c), &[far, far]), 0);
 }
+
+/// Per-state operators for the typed batch: state `i` runs `chains[i]`.
+struct Chains(Vec<Vec<Op>>);
+
+impl covtrace::StateOps for Chains {
+    fn apply<S: Spectrum>(&self, i: usize, s: &mut S) -> Result<(), CovError> {
+        self.0[i].iter().try_for_each(|op| typed(op, s))
+    }
+}
+
+/// `eval_batch_typed` (typed bodies on the unchecked kernels, checked re-run on failure)
+/// gives `eval_batch_with`'s results (operators through `dyn Spectrum`): the same bits,
+/// the same failing states with the same messages, and failed states left as they were.
+fn batches_agree<const N: usize>(d: &[f64], chains: &Chains) -> usize {
+    use covtrace::Form;
+    let mut failed = 0;
+    for form in [Form::Covariance, Form::SquareRoot] {
+        let start: Vec<Cov<N>> = (0..chains.0.len()).map(|i| start::<N>(&d[i % 3..])).collect();
+        let (mut a, mut b) = (start.clone(), start.clone());
+        let fa = covtrace::eval_batch_typed(form, &mut a, chains);
+        let fb = covtrace::eval_batch_with(form, &mut b, |i, s| {
+            chains.0[i].iter().try_for_each(|op| dyn_op(op).apply(s))
+        });
+        let text = |f: &[(usize, CovError)]| f.iter().map(|(i, e)| (*i, e.to_string())).collect::<Vec<_>>();
+        assert_eq!(text(&fa), text(&fb), "{form:?}: failures differ");
+        assert_eq!(a, b, "{form:?}: typed and dynamic batches differ");
+        for (i, _) in &fa {
+            assert_eq!(a[*i], start[*i], "{form:?}: failed state {i} was changed");
+        }
+        failed += fa.len();
+    }
+    failed
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(40))]
+
+    #[test]
+    fn typed_batch_matches_closure_batch(
+        d in prop::collection::vec(prop_oneof![Just(0.0), 1e-3f64..10.0], 8),
+        o in prop::collection::vec(ops(), 1..40),
+    ) {
+        let chains = Chains(
+            o.iter()
+                .map(|c| c.iter().filter_map(|&(k, p, q)| op_of(k, p, q)).collect())
+                .collect(),
+        );
+        batches_agree::<2>(&d, &chains);
+        batches_agree::<4>(&d, &chains);
+        batches_agree::<5>(&d, &chains);
+    }
+}
+
+/// The typed batch reaches its error paths: states that overflow and states whose layout
+/// lacks an axis fail, with the checked kernels' messages, among states that succeed.
+#[test]
+fn typed_batch_reports_failing_states() {
+    let rotate = op_of(7, 0.4, 0.0).expect("valid");
+    let far = Op::Travel(Travel::new(1e200).expect("finite"));
+    let near = Op::Travel(Travel::new(0.5).expect("finite"));
+    let chains = Chains(vec![vec![near], vec![far, far], vec![near, rotate], vec![near]]);
+    // Flatland: the rotation needs y and v (state 2); Σ_uu = 1e400 overflows in
+    // covariance form (state 1), while the factor's rows stay finite but Σ = L Lᵀ
+    // does not (reported when the factor is turned back into Σ).
+    assert_eq!(batches_agree::<2>(&[1.0; 8], &chains), 4);
+    // 4D has the rotation's axes: only the overflow fails, in both forms.
+    assert_eq!(batches_agree::<4>(&[1.0; 8], &chains), 2);
+}

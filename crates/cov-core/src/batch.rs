@@ -197,6 +197,83 @@ pub fn eval_batch_with<const N: usize, F>(form: Form, states: &mut [Cov<N>], ops
 where
     F: Fn(usize, &mut dyn Spectrum) -> Result<(), CovError> + Sync,
 {
+    eval_batch_typed(form, states, &Dyn(ops))
+}
+
+/// Per-state operators for [`eval_batch_typed`]: `apply(i, s)` applies state `i`'s
+/// operators to `s`, whatever the concrete spectrum type `S` is. Being generic (a
+/// closure cannot be), it lets the operators' typed bodies (`apply_to`, the operator
+/// crates' convention) inline the unchecked kernels with constant indices, where the
+/// closure of [`eval_batch_with`] reaches every kernel through `dyn Spectrum`.
+///
+/// ```
+/// use cov_core::{Axis, CovError, Spectrum, StateOps};
+/// /// Travel by a distance of its own per state.
+/// struct Distances(Vec<f64>);
+/// impl StateOps for Distances {
+///     fn apply<S: Spectrum>(&self, i: usize, s: &mut S) -> Result<(), CovError> {
+///         s.shear(Axis::X, Axis::U, -self.0[i])
+///     }
+/// }
+/// # let _ = Distances(vec![1.0]);
+/// ```
+pub trait StateOps: Sync {
+    /// Applies state `i`'s operators to `s`.
+    ///
+    /// # Errors
+    /// What the operators report (a missing axis, say); the batch then reports state `i`.
+    fn apply<S: Spectrum>(&self, i: usize, s: &mut S) -> Result<(), CovError>;
+}
+
+/// The closure of [`eval_batch_with`] as [`StateOps`] (every spectrum through `dyn`).
+struct Dyn<F>(F);
+
+impl<F> StateOps for Dyn<F>
+where
+    F: Fn(usize, &mut dyn Spectrum) -> Result<(), CovError> + Sync,
+{
+    #[inline]
+    fn apply<S: Spectrum>(&self, i: usize, s: &mut S) -> Result<(), CovError> {
+        (self.0)(i, s)
+    }
+}
+
+/// [`eval_batch_with`] with the per-state operators given as [`StateOps`], whose generic
+/// `apply` sees the concrete spectrum: the operators' typed bodies then compile to the
+/// unchecked kernels with constant indices, inlined. Same semantics, same results and
+/// errors as [`eval_batch_with`] with the same operators (each state runs as a chain's
+/// first evaluation does; a state that is not clean runs again on the checked kernels,
+/// which report the failing operator, and is left as it was).
+///
+/// ```
+/// use cov_core::{Axis, Cov, CovError, Form, Spectrum, StateOps, eval_batch_typed};
+/// struct Distances(Vec<f64>);
+/// impl StateOps for Distances {
+///     fn apply<S: Spectrum>(&self, i: usize, s: &mut S) -> Result<(), CovError> {
+///         s.shear(Axis::X, Axis::U, -self.0[i])
+///     }
+/// }
+/// let ops = Distances((0..100).map(|i| 0.1 * i as f64).collect());
+/// let mut states = vec![Cov::<2>::from_diagonal([0.5, 1.0])?; 100];
+/// assert!(eval_batch_typed(Form::Covariance, &mut states, &ops).is_empty());
+/// // Travel spreads spatial content into the direction axis: Σ_uu = 1 + d² Σ_xx.
+/// assert!((states[99].get(1, 1) - (1.0 + 9.9f64.powi(2) * 0.5)).abs() < 1e-12);
+/// // A layout without the axis fails state by state, with the operator's own error.
+/// let mut flat = vec![Cov::<2>::from_diagonal([0.5, 1.0])?; 3];
+/// struct Turn;
+/// impl StateOps for Turn {
+///     fn apply<S: Spectrum>(&self, _: usize, s: &mut S) -> Result<(), CovError> {
+///         s.shear(Axis::Y, Axis::V, 1.0)
+///     }
+/// }
+/// assert_eq!(eval_batch_typed(Form::Covariance, &mut flat, &Turn).len(), 3);
+/// # Ok::<(), CovError>(())
+/// ```
+pub fn eval_batch_typed<const N: usize, O: StateOps>(
+    form: Form,
+    states: &mut [Cov<N>],
+    ops: &O,
+) -> Vec<(usize, CovError)> {
     let one = |i: usize, s: &mut Cov<N>| -> Result<(), CovError> {
         let finite = |sp: &dyn Spectrum| match sp.first_non_finite() {
             None => Ok(()),
@@ -213,19 +290,19 @@ where
         match form {
             Form::Covariance => {
                 let mut c = *s;
-                if ops(i, &mut Direct(&mut c)).is_ok() && c.all_finite() {
+                if ops.apply(i, &mut Direct(&mut c)).is_ok() && c.all_finite() {
                     *s = c;
                     return Ok(());
                 }
                 let mut c = *s;
-                ops(i, &mut c)?;
+                ops.apply(i, &mut c)?;
                 finite(&c)?;
                 *s = c;
             }
             Form::SquareRoot => {
                 let start = CovFactor::from_cov(s);
                 let mut f = start;
-                if ops(i, &mut Direct(&mut f)).is_ok()
+                if ops.apply(i, &mut Direct(&mut f)).is_ok()
                     && f.all_finite()
                     && let Ok(c) = f.to_cov()
                 {
@@ -233,7 +310,7 @@ where
                     return Ok(());
                 }
                 let mut f = start;
-                ops(i, &mut f)?;
+                ops.apply(i, &mut f)?;
                 finite(&f)?;
                 *s = f.to_cov()?;
             }

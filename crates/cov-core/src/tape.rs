@@ -836,17 +836,17 @@ impl<K: Kernels> Spectrum for Direct<'_, K> {
         self.0.k_congruence(a);
         Ok(())
     }
-    #[inline]
+    #[inline(always)]
     fn raw_shear(&mut self, _op: &str, i: usize, j: usize, s: f64) -> Result<(), CovError> {
         self.0.k_shear(i, j, s);
         Ok(())
     }
-    #[inline]
+    #[inline(always)]
     fn raw_scale(&mut self, _op: &str, i: usize, c: f64) -> Result<(), CovError> {
         self.0.k_scale(i, c);
         Ok(())
     }
-    #[inline]
+    #[inline(always)]
     fn raw_rotate(&mut self, _op: &str, planes: &[(usize, usize)], c: f64, s: f64) -> Result<(), CovError> {
         for &(i, j) in planes {
             self.0.k_rotate(i, j, c, s);
@@ -858,7 +858,7 @@ impl<K: Kernels> Spectrum for Direct<'_, K> {
         self.0.k_add_window(p, w);
         Ok(())
     }
-    #[inline]
+    #[inline(always)]
     fn raw_add_variance(&mut self, op: &str, i: usize, w: f64) -> Result<(), CovError> {
         // The square-root form folds with reflections, which would spread an ∞ as NaN:
         // the end check still sees it, but check first to keep the fold finite.
@@ -868,7 +868,7 @@ impl<K: Kernels> Spectrum for Direct<'_, K> {
         self.0.k_add_variance(i, w);
         Ok(())
     }
-    #[inline]
+    #[inline(always)]
     fn raw_lobe_1(&mut self, op: &str, p: usize, s: f64) -> Result<(), CovError> {
         if !K::LOBE_1_KEEPS_NON_FINITE {
             self.finite(op)?;
