@@ -199,6 +199,8 @@ pub(crate) enum Instr {
         /// Second parameter.
         b: f64,
     },
+    /// Variances added on several axes at once (square-root form), as the factor of the
+    /// window: `m` holds `√w` on its diagonal, computed once when the tape is lowered.
     Window(Box<Block>),
     General(usize),
 }
@@ -207,7 +209,9 @@ pub(crate) enum Instr {
 /// operator makes on the two transverse planes ([`pair`]) become one instruction; in
 /// square-root form, a run of variances added on distinct axes becomes one window (each
 /// `AddVariance` folds the factor back with Householder reflections, the form's most
-/// expensive kernel; one fold of `k` new columns does the work of `k`, to rounding).
+/// expensive kernel; one fold of `k` new columns does the work of `k`, to rounding), and
+/// a multi-axis window keeps the factor of its matrix, computed here once (the same bits
+/// as factoring it at every run).
 ///
 /// Runs of rule-1 kernels are not composed into one dense map: tried, it cut the
 /// covariance bounce chain by a quarter, but the stiff suite's 10⁴-operator chain lost a
@@ -229,7 +233,8 @@ fn plan<K: Kernels>(kernels: &[Kernel]) -> Vec<Instr> {
             for k in &kernels[q..] {
                 match *k {
                     Kernel::AddVariance { i, w: v } if (i as usize) < n && !idx.contains(&(i as usize)) => {
-                        w[idx.len()][idx.len()] = v;
+                        // The window's factor, as `k_add_window` would take it (`v ≥ 0`).
+                        w[idx.len()][idx.len()] = v.max(0.0).sqrt();
                         idx.push(i as usize);
                     }
                     _ => break,
@@ -238,6 +243,15 @@ fn plan<K: Kernels>(kernels: &[Kernel]) -> Vec<Instr> {
             if idx.len() >= 2 {
                 q += idx.len();
                 out.push(Instr::Window(Block::new(&idx, &w)));
+                continue;
+            }
+            // A multi-axis window: its factor once, here, instead of at every run.
+            if let Kernel::AddWindow(b) = &kernels[q]
+                && b.p[..b.k].iter().all(|&i| i < n)
+            {
+                let f = crate::form::psd_factor(b.k, &b.m);
+                out.push(Instr::Window(Block::new(&b.p[..b.k], &f)));
+                q += 1;
                 continue;
             }
         }
@@ -597,10 +611,10 @@ impl Tape {
                     }
                     if local {
                         let mut t = *w;
-                        t.k_add_window(&b.p[..b.k], &b.m);
+                        t.k_add_window_factor(&b.p[..b.k], &b.m);
                         *w = t;
                     } else {
-                        w.k_add_window(&b.p[..b.k], &b.m);
+                        w.k_add_window_factor(&b.p[..b.k], &b.m);
                     }
                 }
                 Instr::General(q) => {

@@ -42,8 +42,8 @@ pub const ROW_SNAP: f64 = 1.1920928955078125e-7;
 /// Columns of the largest pre-array: `N` plus up to `N` appended or lobe columns.
 const W: usize = 2 * MAX;
 
-/// A work array for a fold: the factor's `N ≤ 5` rows with up to `2N` columns.
-type Work = [[f64; W]; MAX];
+/// A work array for a fold: the factor's `N` rows with up to `2N` columns.
+type Work<const N: usize> = [[f64; W]; N];
 
 /// Σ in square-root form: `Σ = L Lᵀ`, `L` an `N × N` real matrix, row `i` for axis `i`.
 ///
@@ -363,6 +363,9 @@ impl<const N: usize> Kernels for CovFactor<N> {
     fn k_add_window(&mut self, p: &[usize], w: &Small) {
         self.l = self.add_window_new(p, w);
     }
+    fn k_add_window_factor(&mut self, p: &[usize], f: &Small) {
+        self.l = self.add_columns_new(p, f);
+    }
     fn k_lobe(&mut self, p: &[usize], s: &Small) {
         self.l = self.lobe_new(p, s);
     }
@@ -406,8 +409,9 @@ impl<const N: usize> CovFactor<N> {
     }
 
     /// The factor in a work array, columns `0..N`.
-    fn work(&self) -> Work {
-        let mut m = [[0.0; W]; MAX];
+    #[inline(always)]
+    fn work(&self) -> Work<N> {
+        let mut m = [[0.0; W]; N];
         for i in 0..N {
             m[i][..N].copy_from_slice(&self.l[i]);
         }
@@ -418,7 +422,7 @@ impl<const N: usize> CovFactor<N> {
     /// `N` columns are non-zero (a rank-deficient Σ has free columns: a source constant
     /// along an axis, an integrated axis), they are only packed side by side, exactly;
     /// otherwise Householder reflections from the right triangularise `M`.
-    fn fold_new(mut m: Work, cols: usize) -> [[f64; N]; N] {
+    fn fold_new(m: &mut Work<N>, cols: usize) -> [[f64; N]; N] {
         let mut used = [0usize; W];
         let mut n_used = 0;
         for c in 0..cols {
@@ -437,9 +441,9 @@ impl<const N: usize> CovFactor<N> {
             return new;
         }
         match cols - N {
-            1 => lq_fold::<N, 1>(&mut m),
-            2 => lq_fold::<N, 2>(&mut m),
-            _ => lq(&mut m, 0, N, N, cols),
+            1 => lq_fold::<N, 1>(m),
+            2 => lq_fold::<N, 2>(m),
+            _ => lq(m, 0, N, N, cols),
         }
         let mut new = [[0.0; N]; N];
         for i in 0..N {
@@ -461,15 +465,20 @@ impl<const N: usize> CovFactor<N> {
 
     /// The factor of `Σ + W` on the indices `p`.
     fn add_window_new(&self, p: &[usize], w: &Small) -> [[f64; N]; N] {
+        self.add_columns_new(p, &psd_factor(p.len(), w))
+    }
+
+    /// The factor of `Σ + F Fᵀ` on the indices `p` (`F` is `k × k`): `F`'s columns
+    /// appended to `L`, then folded back to `N` columns.
+    fn add_columns_new(&self, p: &[usize], f: &Small) -> [[f64; N]; N] {
         let k = p.len();
-        let wf = psd_factor(k, w);
         let mut m = self.work();
         for a in 0..k {
             for c in 0..k {
-                m[p[a]][N + c] = wf[a][c];
+                m[p[a]][N + c] = f[a][c];
             }
         }
-        Self::fold_new(m, N + k)
+        Self::fold_new(&mut m, N + k)
     }
 
     /// The factor of `Σ + w e_i e_iᵀ`.
@@ -477,7 +486,7 @@ impl<const N: usize> CovFactor<N> {
     fn add_variance_new(&self, i: usize, w: f64) -> [[f64; N]; N] {
         let mut m = self.work();
         m[i][N] = w.sqrt();
-        Self::fold_new(m, N + 1)
+        Self::fold_new(&mut m, N + 1)
     }
 
     /// Rule 3. A diagonal `S` (the usual lobe, and integration) is done as one-axis
@@ -645,7 +654,7 @@ fn lq<const R: usize>(m: &mut [[f64; W]; R], r0: usize, r1: usize, rows: usize, 
 /// [`lq`] of a fold (`N` rows, `N + K` columns) with every size and row index a
 /// constant, so that the compiler unrolls each reflection: the same operations in the
 /// same order (the same bits), fewer instructions.
-fn lq_fold<const N: usize, const K: usize>(m: &mut Work) {
+fn lq_fold<const N: usize, const K: usize>(m: &mut Work<N>) {
     householder_row(m, 0, N, N + K);
     if N > 1 {
         householder_row(m, 1, N, N + K);
@@ -711,7 +720,7 @@ fn householder_row<const R: usize>(m: &mut [[f64; W]; R], r: usize, rows: usize,
 
 /// A factor `F` (k × k) of a symmetric PSD block, `F Fᵀ = S`, from its eigenvectors
 /// (negative rounding eigenvalues count as 0). A diagonal block is factored exactly.
-fn psd_factor(k: usize, s: &Small) -> Small {
+pub(crate) fn psd_factor(k: usize, s: &Small) -> Small {
     let mut f = [[0.0; MAX]; MAX];
     let diagonal = (0..k).all(|a| (0..k).all(|b| a == b || s[a][b] == 0.0));
     if diagonal {

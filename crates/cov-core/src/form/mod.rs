@@ -6,6 +6,7 @@ pub(crate) mod cov;
 mod factor;
 
 pub use cov::SCHUR_SNAP;
+pub(crate) use factor::psd_factor;
 pub use factor::{CovFactor, ROW_SNAP};
 
 /// Where a form's finiteness check failed, as (row, column, value).
@@ -59,6 +60,19 @@ pub(crate) trait Kernels: crate::Spectrum + Copy + Send + Sync + 'static {
     fn k_add_variance(&mut self, i: usize, w: f64);
     fn k_lobe_1(&mut self, p: usize, s: f64);
     fn k_add_window(&mut self, p: &[usize], w: &crate::linalg::Small);
+    /// [`Kernels::k_add_window`] given a factor `F` of the window (`W = F Fᵀ`, `k × k`),
+    /// as a compiled chain holds it: the square-root form appends `F`'s columns without
+    /// factoring `W` again.
+    fn k_add_window_factor(&mut self, p: &[usize], f: &crate::linalg::Small) {
+        let k = p.len();
+        let mut w = [[0.0; crate::linalg::MAX]; crate::linalg::MAX];
+        for a in 0..k {
+            for b in 0..k {
+                w[a][b] = (0..k).map(|c| f[a][c] * f[b][c]).sum();
+            }
+        }
+        self.k_add_window(p, &w);
+    }
     fn k_lobe(&mut self, p: &[usize], s: &crate::linalg::Small);
     fn k_congruence(&mut self, a: &crate::linalg::Small);
     /// Whether every stored number is finite.
