@@ -422,7 +422,7 @@ impl<const N: usize> CovFactor<N> {
     /// `N` columns are non-zero (a rank-deficient Σ has free columns: a source constant
     /// along an axis, an integrated axis), they are only packed side by side, exactly;
     /// otherwise Householder reflections from the right triangularise `M`.
-    fn fold_new(m: &mut Work<N>, cols: usize) -> [[f64; N]; N] {
+    fn fold_new(mut m: Work<N>, cols: usize) -> [[f64; N]; N] {
         let mut used = [0usize; W];
         let mut n_used = 0;
         for c in 0..cols {
@@ -441,9 +441,9 @@ impl<const N: usize> CovFactor<N> {
             return new;
         }
         match cols - N {
-            1 => lq_fold::<N, 1>(m),
-            2 => lq_fold::<N, 2>(m),
-            _ => lq(m, 0, N, N, cols),
+            1 => lq_fold::<N, 1>(&mut m),
+            2 => lq_fold::<N, 2>(&mut m),
+            _ => lq(&mut m, 0, N, N, cols),
         }
         let mut new = [[0.0; N]; N];
         for i in 0..N {
@@ -478,7 +478,7 @@ impl<const N: usize> CovFactor<N> {
                 m[p[a]][N + c] = f[a][c];
             }
         }
-        Self::fold_new(&mut m, N + k)
+        Self::fold_new(m, N + k)
     }
 
     /// The factor of `Σ + w e_i e_iᵀ`.
@@ -486,7 +486,7 @@ impl<const N: usize> CovFactor<N> {
     fn add_variance_new(&self, i: usize, w: f64) -> [[f64; N]; N] {
         let mut m = self.work();
         m[i][N] = w.sqrt();
-        Self::fold_new(&mut m, N + 1)
+        Self::fold_new(m, N + 1)
     }
 
     /// Rule 3. A diagonal `S` (the usual lobe, and integration) is done as one-axis
