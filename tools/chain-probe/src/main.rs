@@ -1,14 +1,17 @@
-//! The 10-operator bounce chain of `benches/chain.rs` at N = 4 with fixed parameters, run
-//! on 4,096 states (`mode` picks what runs; each `*none` mode is the same loop without
-//! the chain). Run under `valgrind --tool=callgrind` by `count.sh`, which subtracts the
-//! loop and divides by the states.
+//! The 10-operator bounce chain of `benches/chain.rs` on 4,096 states (`mode` picks what
+//! runs; each `*-none` mode is the same loop without the chain). At N = 4 with fixed
+//! parameters: the baseline, `Chain::apply` in both forms. With per-state parameters
+//! (each state's operators built for it) at N = 2, 4, 5: `eval_batch_with` (a closure
+//! over `dyn Spectrum`) and `eval_batch_typed` (`StateOps`, the operators' typed bodies),
+//! covariance form. Run under `valgrind --tool=callgrind` by `count.sh` (one rayon
+//! thread), which subtracts the loop and divides by the states.
 
 use covtrace::brdf::{Brdf, Lobe};
 use covtrace::curvature::Curvature;
 use covtrace::occlusion::Window;
 use covtrace::projection::{Mirror, Project, RotateFrame, Unproject};
 use covtrace::travel::Travel;
-use covtrace::{Chain, Cov, CovFactor, Operator};
+use covtrace::{Chain, Cov, CovError, CovFactor, Form, Operator, Spectrum, StateOps};
 use glam::DVec3;
 use std::hint::black_box;
 
@@ -17,6 +20,119 @@ use std::hint::black_box;
 mod baseline;
 
 const STATES: usize = 4096;
+
+/// State `i`'s bounce chain: the fixed ray with its distances varied per state.
+struct PerState {
+    dir: DVec3,
+    fx: DVec3,
+    n: DVec3,
+    dim: usize,
+}
+
+/// One state's operators.
+struct Built {
+    t1: Travel,
+    project: Project,
+    k: Curvature,
+    lobe: Brdf,
+    k_back: Curvature,
+    unproject: Unproject,
+    turn: Option<RotateFrame>,
+    t2: Travel,
+    window: Window,
+}
+
+impl PerState {
+    #[inline(always)]
+    fn build(&self, i: usize) -> Result<Built, CovError> {
+        let d = 1.0 + (i % 13) as f64 * 0.1;
+        let mut project = Project::from_vectors(self.dir, self.fx, self.n)?;
+        let mut out = 0.4;
+        if self.dim < 4 {
+            project = Project::new(project.cos())?;
+            out = 0.0;
+        }
+        Ok(Built {
+            t1: Travel::new(d)?,
+            project,
+            k: Curvature::isotropic(0.7)?,
+            lobe: Brdf::new(Lobe::Phong { exponent: 80.0 })?,
+            k_back: Curvature::isotropic(-0.7)?,
+            unproject: Unproject::with_angle(0.6, out)?,
+            turn: if self.dim >= 4 {
+                Some(RotateFrame::new(0.9)?)
+            } else {
+                None
+            },
+            t2: Travel::new(2.0 * d)?,
+            window: Window::isotropic(0.2)?,
+        })
+    }
+}
+
+impl Built {
+    /// Through the typed bodies.
+    #[inline(always)]
+    fn typed<S: Spectrum>(&self, s: &mut S) -> Result<(), CovError> {
+        self.t1.apply_to(s)?;
+        self.project.apply_to(s)?;
+        self.k.apply_to(s)?;
+        Mirror.apply_to(s)?;
+        self.lobe.apply_to(s)?;
+        self.k_back.apply_to(s)?;
+        self.unproject.apply_to(s)?;
+        if let Some(t) = &self.turn {
+            t.apply_to(s)?;
+        }
+        self.t2.apply_to(s)?;
+        self.window.apply_to(s)
+    }
+
+    /// Through `Operator::apply`.
+    fn dynamic(&self, s: &mut dyn Spectrum) -> Result<(), CovError> {
+        let ops: [Option<&dyn Operator>; 10] = [
+            Some(&self.t1),
+            Some(&self.project),
+            Some(&self.k),
+            Some(&Mirror),
+            Some(&self.lobe),
+            Some(&self.k_back),
+            Some(&self.unproject),
+            self.turn.as_ref().map(|t| t as &dyn Operator),
+            Some(&self.t2),
+            Some(&self.window),
+        ];
+        ops.into_iter().flatten().try_for_each(|op| op.apply(s))
+    }
+}
+
+impl StateOps for PerState {
+    fn apply<S: Spectrum>(&self, i: usize, s: &mut S) -> Result<(), CovError> {
+        self.build(i)?.typed(s)
+    }
+}
+
+/// `eval_batch_with` (`typed` false) or `eval_batch_typed` over 4,096 states of layout `N`.
+fn per_state<const N: usize>(p: &PerState, run: bool, typed: bool) {
+    let mut s: Vec<Cov<N>> = (0..STATES)
+        .map(|i| {
+            let f = 1.0 + (i % 17) as f64 * 0.1;
+            let mut d = [1.5; N];
+            d[0] = 0.1 * f;
+            d[N / 2] = 3.0 / f;
+            Cov::<N>::gaussian(d).expect("finite stds")
+        })
+        .collect();
+    if run {
+        let failed = if typed {
+            covtrace::eval_batch_typed(Form::Covariance, &mut s, p)
+        } else {
+            covtrace::eval_batch_with(Form::Covariance, &mut s, |i, c| p.build(i)?.dynamic(c))
+        };
+        assert!(failed.is_empty());
+    }
+    black_box(&s);
+}
 
 fn main() {
     let mode = std::env::args().nth(1).unwrap_or_default();
@@ -99,8 +215,21 @@ fn main() {
             }
             black_box(&s);
         }
+        m if m.starts_with("with-") || m.starts_with("typed-") => {
+            let dim = m.chars().find_map(|c| c.to_digit(10)).unwrap_or(4) as usize;
+            let p = PerState { dir, fx, n, dim };
+            let run = !m.ends_with("-none");
+            let typed = m.starts_with("typed");
+            match dim {
+                2 => per_state::<2>(&p, run, typed),
+                5 => per_state::<5>(&p, run, typed),
+                _ => per_state::<4>(&p, run, typed),
+            }
+        }
         _ => {
-            eprintln!("usage: chain-probe base|base-none|cov|cov-none|sqrt|sqrt-none");
+            eprintln!(
+                "usage: chain-probe base|cov|sqrt|with-2|typed-2|with-4|typed-4|with-5|typed-5 (or its -none loop)"
+            );
             std::process::exit(2);
         }
     }
