@@ -26,10 +26,9 @@ use std::time::{Duration, Instant};
 
 use covtrace::brdf::{Brdf, Lobe};
 use covtrace::curvature::Curvature;
-use covtrace::occlusion::Window;
-use covtrace::projection::{Mirror, Project, RotateFrame, Unproject};
+use covtrace::projection::{Mirror, Project, RotateFrame};
 use covtrace::travel::Travel;
-use covtrace::{Chain, Cov, CovError, CovFactor, CovLanes, Form, Operator, Spectrum, StateOps, Tape};
+use covtrace::{Cov, CovError, CovFactor, CovLanes, Form, Operator, Spectrum, StateOps, Tape};
 use criterion::{BatchSize, Bencher, Criterion, Throughput, criterion_group, criterion_main};
 use glam::DVec3;
 use rand::{Rng, SeedableRng};
@@ -38,8 +37,11 @@ use rand_chacha::ChaCha8Rng;
 #[path = "common/baseline.rs"]
 mod baseline;
 mod common;
+#[path = "common/ops.rs"]
+mod ops;
 use baseline::{Fixed, Packed, Ray};
 use common::{BATCH, random_covs};
+use ops::Ops;
 
 fn unit(rng: &mut ChaCha8Rng) -> DVec3 {
     loop {
@@ -78,105 +80,6 @@ fn rays(rng: &mut ChaCha8Rng) -> Vec<Ray> {
             }
         })
         .collect()
-}
-
-/// The library's 10 operators for ray `r` in layout `n`.
-struct Ops {
-    t1: Travel,
-    project: Project,
-    k: Curvature,
-    lobe: Brdf,
-    k_back: Curvature,
-    unproject: Unproject,
-    turn: Option<RotateFrame>,
-    t2: Travel,
-    window: Window,
-}
-
-impl Ops {
-    #[inline(always)]
-    fn new(r: &Ray, n: usize) -> Ops {
-        let v = |a: [f64; 3]| DVec3::from_array(a);
-        let mut project = Project::from_vectors(v(r.dir), v(r.fx), v(r.n)).expect("unit vectors");
-        let mut out = r.angle_out;
-        if n < 4 {
-            project = Project::new(project.cos()).expect("cosine");
-            out = 0.0;
-        }
-        Ops {
-            t1: Travel::new(r.d1).expect("distance"),
-            project,
-            k: Curvature::isotropic(r.k).expect("curvature"),
-            lobe: Brdf::new(Lobe::Phong { exponent: r.e }).expect("lobe"),
-            k_back: Curvature::isotropic(-r.k).expect("curvature"),
-            unproject: Unproject::with_angle(r.cos_out, out).expect("cosine"),
-            turn: (n >= 4).then(|| RotateFrame::new(r.turn).expect("angle")),
-            t2: Travel::new(r.d2).expect("distance"),
-            window: Window::isotropic(r.std).expect("std"),
-        }
-    }
-
-    #[inline(always)]
-    fn list(&self) -> [Option<&dyn Operator>; 10] {
-        [
-            Some(&self.t1),
-            Some(&self.project),
-            Some(&self.k),
-            Some(&Mirror),
-            Some(&self.lobe),
-            Some(&self.k_back),
-            Some(&self.unproject),
-            self.turn.as_ref().map(|t| t as &dyn Operator),
-            Some(&self.t2),
-            Some(&self.window),
-        ]
-    }
-
-    #[inline(always)]
-    fn apply(&self, s: &mut dyn Spectrum) -> bool {
-        self.list().into_iter().flatten().all(|op| op.apply(s).is_ok())
-    }
-
-    /// The same operators through their typed bodies (`apply_to`): the spectrum's type
-    /// is known here, so the kernels inline with constant indices.
-    #[inline(always)]
-    fn apply_typed<S: Spectrum>(&self, s: &mut S) -> bool {
-        self.try_typed(s).is_ok()
-    }
-
-    /// [`Ops::apply_typed`] with the first error.
-    #[inline(always)]
-    fn try_typed<S: Spectrum>(&self, s: &mut S) -> Result<(), CovError> {
-        self.t1.apply_to(s)?;
-        self.project.apply_to(s)?;
-        self.k.apply_to(s)?;
-        Mirror.apply_to(s)?;
-        self.lobe.apply_to(s)?;
-        self.k_back.apply_to(s)?;
-        self.unproject.apply_to(s)?;
-        if let Some(t) = &self.turn {
-            t.apply_to(s)?;
-        }
-        self.t2.apply_to(s)?;
-        self.window.apply_to(s)
-    }
-
-    fn chain(&self) -> Chain {
-        let mut c = Chain::new();
-        c.push(self.t1);
-        c.push(self.project);
-        c.push(self.k);
-        c.push(Mirror);
-        c.push(self.lobe);
-        c.push(self.k_back);
-        c.push(self.unproject);
-        if let Some(t) = self.turn {
-            c.push(t);
-        }
-        c.push(self.t2);
-        c.push(self.window);
-        c
-    }
 }
 
 /// Each ray's operators, built per state and applied through their typed bodies: the
@@ -443,13 +346,8 @@ fn bounce_n<const N: usize>(c: &mut Criterion, rng: &mut ChaCha8Rng) {
         ("covariance", Form::Covariance),
         ("square root", Form::SquareRoot),
     ] {
-        let per_ray = |i: usize, s: &mut dyn covtrace::Spectrum| {
-            let ops = Ops::new(&rays[i % rays.len()], N);
-            for op in ops.list().into_iter().flatten() {
-                op.apply(s)?;
-            }
-            Ok(())
-        };
+        let per_ray =
+            |i: usize, s: &mut dyn covtrace::Spectrum| Ops::new(&rays[i % rays.len()], N).try_dyn(s);
         for (threads, p) in &pools {
             g.bench_function(format!("per-ray: eval_batch_with ({name}, {threads})"), |b| {
                 batch(b, p, &|s| covtrace::eval_batch_with(form, s, per_ray).len())
