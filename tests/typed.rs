@@ -180,7 +180,13 @@ fn batches_agree<const N: usize>(d: &[f64], chains: &Chains) -> usize {
         let fb = covtrace::eval_batch_with(form, &mut b, |i, s| {
             chains.0[i].iter().try_for_each(|op| dyn_op(op).apply(s))
         });
-        let text = |f: &[(usize, CovError)]| f.iter().map(|(i, e)| (*i, e.to_string())).collect::<Vec<_>>();
+        // A state left non-finite with no operator error is reported under the batch's
+        // own name, which differs between the two; everything else must be identical.
+        let text = |f: &[(usize, CovError)]| {
+            f.iter()
+                .map(|(i, e)| (*i, e.to_string().replace("eval_batch_typed", "eval_batch_with")))
+                .collect::<Vec<_>>()
+        };
         assert_eq!(text(&fa), text(&fb), "{form:?}: failures differ");
         assert_eq!(a, b, "{form:?}: typed and dynamic batches differ");
         for (i, _) in &fa {

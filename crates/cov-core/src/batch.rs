@@ -1,5 +1,6 @@
 //! Batch evaluation: one chain over many states ([`Chain::eval_batch`]), what a renderer
-//! calls for a tile of paths, and per-state operators ([`eval_batch_with`]). The chain
+//! calls for a tile of paths, and per-state operators ([`eval_batch_with`], and
+//! [`eval_batch_typed`] for operators applied through their typed bodies). The chain
 //! is compiled once ([`Tape`]); states run in parallel over cores (rayon, in chunks of
 //! [`CHUNK`]). In covariance form, groups of [`LANES`] states are stored
 //! structure-of-arrays (each entry of Σ one contiguous array over the group), and the
@@ -179,6 +180,9 @@ impl Chain {
 /// Returns the states that failed with what `ops` reported, or an overflow if `ops`
 /// left Σ non-finite; those states are left as they were.
 ///
+/// Operators whose typed bodies are known (`apply_to` in the operator crates) run
+/// faster through [`eval_batch_typed`], which takes them as a [`StateOps`] value.
+///
 /// ```
 /// use cov_core::{Axis, Cov, CovError, Form, Spectrum, eval_batch_with};
 /// // Travel by a distance of its own per state.
@@ -197,7 +201,7 @@ pub fn eval_batch_with<const N: usize, F>(form: Form, states: &mut [Cov<N>], ops
 where
     F: Fn(usize, &mut dyn Spectrum) -> Result<(), CovError> + Sync,
 {
-    eval_batch_typed(form, states, &Dyn(ops))
+    each_state(form, states, &Dyn(ops), "eval_batch_with")
 }
 
 /// Per-state operators for [`eval_batch_typed`]: `apply(i, s)` applies state `i`'s
@@ -274,11 +278,22 @@ pub fn eval_batch_typed<const N: usize, O: StateOps>(
     states: &mut [Cov<N>],
     ops: &O,
 ) -> Vec<(usize, CovError)> {
+    each_state(form, states, ops, "eval_batch_typed")
+}
+
+/// The body of [`eval_batch_with`] and [`eval_batch_typed`]; `name` is the caller's,
+/// for the overflow of a state that `ops` left non-finite without an error of its own.
+fn each_state<const N: usize, O: StateOps>(
+    form: Form,
+    states: &mut [Cov<N>],
+    ops: &O,
+    name: &str,
+) -> Vec<(usize, CovError)> {
     let one = |i: usize, s: &mut Cov<N>| -> Result<(), CovError> {
         let finite = |sp: &dyn Spectrum| match sp.first_non_finite() {
             None => Ok(()),
             Some((row, col, value)) => Err(CovError::Overflow {
-                operator: "eval_batch_with".into(),
+                operator: name.into(),
                 row,
                 col,
                 value,
