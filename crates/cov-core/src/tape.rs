@@ -199,8 +199,9 @@ pub(crate) enum Instr {
         /// Second parameter.
         b: f64,
     },
-    /// Variances added on several axes at once (square-root form), as the factor of the
-    /// window: `m` holds `√w` on its diagonal, computed once when the tape is lowered.
+    /// A window on several axes (square-root form), held as its factor `F` (`W = F Fᵀ`),
+    /// computed once when the tape is lowered: `√w` on the diagonal for a run of
+    /// variances, [`crate::form::psd_factor`] of the matrix for a multi-axis window.
     Window(Box<Block>),
     General(usize),
 }
