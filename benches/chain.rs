@@ -96,6 +96,17 @@ impl StateOps for PerRay<'_> {
     }
 }
 
+/// One ray's operators, built once and shared by every state, through their typed
+/// bodies: the fixed chain as a Rust caller that knows its operators writes it.
+struct Shared(Ops);
+
+impl StateOps for Shared {
+    #[inline(always)]
+    fn apply<S: Spectrum>(&self, _: usize, s: &mut S) -> Result<(), CovError> {
+        self.0.try_typed(s)
+    }
+}
+
 fn packed<const N: usize>(c: &Cov<N>) -> Packed<N> {
     let mut p = [0.0; 15];
     p[..c.packed().len()].copy_from_slice(c.packed());
@@ -331,6 +342,18 @@ fn bounce_n<const N: usize>(c: &mut Criterion, rng: &mut ChaCha8Rng) {
         for (threads, p) in &pools {
             g.bench_function(format!("fixed: Chain::eval_batch ({name}, {threads})"), |b| {
                 batch(b, p, &|s| chain.eval_batch(form, s).len())
+            });
+        }
+    }
+    // The same fixed operators through their typed bodies (no tape).
+    let shared = Shared(Ops::new(&rays[0], N));
+    for (name, form) in [
+        ("covariance", Form::Covariance),
+        ("square root", Form::SquareRoot),
+    ] {
+        for (threads, p) in &pools {
+            g.bench_function(format!("fixed: eval_batch_typed ({name}, {threads})"), |b| {
+                batch(b, p, &|s| covtrace::eval_batch_typed(form, s, &shared).len())
             });
         }
     }

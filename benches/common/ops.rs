@@ -31,12 +31,14 @@ impl Ops {
     #[inline(always)]
     pub fn new(r: &Ray, n: usize) -> Ops {
         let v = |a: [f64; 3]| DVec3::from_array(a);
-        let mut project = Project::from_vectors(v(r.dir), v(r.fx), v(r.n)).expect("unit vectors");
-        let mut out = r.angle_out;
-        if n < 4 {
-            project = Project::new(project.cos()).expect("cosine");
-            out = 0.0;
-        }
+        // Flatland has no frame to turn: its projection is built from the cosine alone
+        // (the same value `from_vectors` computes).
+        let (project, out) = if n >= 4 {
+            let p = Project::from_vectors(v(r.dir), v(r.fx), v(r.n)).expect("unit vectors");
+            (p, r.angle_out)
+        } else {
+            (Project::new(v(r.dir).dot(v(r.n)).abs()).expect("cosine"), 0.0)
+        };
         Ops {
             t1: Travel::new(r.d1).expect("distance"),
             project,

@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Instructions per state of the bounce chain (callgrind, the loop without the chain
 # subtracted): at N = 4 with fixed parameters, the bench's closed-form baseline and
-# Chain::apply in covariance and square-root form; with per-state parameters, covariance
+# Chain::apply in covariance and square-root form, and eval_batch_typed with the operators
+# built once (fixed-typed: their typed bodies, no tape); with per-state parameters, covariance
 # form, eval_batch_with against eval_batch_typed at N = 2, 4, 5 (one rayon thread).
 # Counts repeat exactly, whatever the load.
 set -euo pipefail
@@ -13,7 +14,7 @@ count() {
 }
 printf '%-26s %8s %8s\n' 'N = 4, fixed parameters' 'instr.' 'ratio'
 base=""
-for m in base cov sqrt; do
+for m in base cov sqrt fixed-typed; do
   with=$(count "$m")
   without=$(count "$m-none")
   per=$(( (with - without) / 4096 ))

@@ -88,7 +88,7 @@
 
 pub mod spec;
 
-use cov_core::{Axis, CovError, FOUR_PI_SQ, Operator, Spectrum};
+use cov_core::{Axis, CovError, FOUR_PI_SQ, Operator, Spectrum, Turn};
 use cov_curvature::Curvature;
 use cov_projection::{Mirror, Project, Unproject};
 
@@ -211,7 +211,7 @@ impl Lobe {
     ///
     /// # Errors
     /// Overflow.
-    #[inline]
+    #[inline(always)]
     pub fn apply_to<S: Spectrum + ?Sized>(&self, cov: &mut S) -> Result<(), CovError> {
         let (vu, vv) = self.variances();
         // Written out per axis (not a loop over `direction_axes`), so that a caller that
@@ -268,7 +268,7 @@ impl Brdf {
     ///
     /// # Errors
     /// As [`Operator::apply`].
-    #[inline]
+    #[inline(always)]
     pub fn apply_to<S: Spectrum + ?Sized>(&self, cov: &mut S) -> Result<(), CovError> {
         self.lobe.apply_to(cov)
     }
@@ -289,7 +289,7 @@ pub struct Reflect {
     project: Project,
     curvature: Curvature,
     lobe: Lobe,
-    turn: f64,
+    turn: Turn,
     unproject: Unproject,
 }
 
@@ -325,7 +325,7 @@ impl Reflect {
             project: Project::new(cos_in)?,
             curvature,
             lobe: lobe.validated()?,
-            turn: CovError::require_finite(Self::NAME, "turn", turn)?,
+            turn: Turn::new(Self::NAME, "turn", turn)?,
             unproject: Unproject::new(cos_out)?,
         })
     }
@@ -339,15 +339,15 @@ impl Operator for Reflect {
         self.curvature.apply_oblique(cov, self.project.cos(), 1.0)?;
         Operator::apply(&Mirror, cov)?;
         self.lobe.apply_to(cov)?;
-        if self.turn != 0.0 {
-            cov.rotate_frame(self.turn)?;
+        if self.turn.angle() != 0.0 {
+            cov.rotate_frame_by(self.turn)?;
         }
         self.curvature.apply_oblique(cov, self.unproject.cos(), -1.0)?;
         Operator::apply(&self.unproject, cov)
     }
     fn requires(&self) -> cov_core::AxisSet {
         let r = Operator::requires(&self.curvature);
-        if self.turn != 0.0 {
+        if self.turn.angle() != 0.0 {
             r.union(cov_core::AxisSet::SPACE)
         } else {
             r

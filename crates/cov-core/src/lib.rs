@@ -92,7 +92,7 @@ pub use operator::{Chain, Operator, Step, Trace, check_layout};
 pub use query::{CovBlock, Filter, NYQUIST_K, primal_std_of_spectrum};
 pub use report::{Field, Report, ReportField};
 pub use spec::{OperatorReader, OperatorSpec, Param, Registrar};
-pub use spectrum::{Concrete, Form, Spectrum, transverse_pairs};
+pub use spectrum::{Concrete, Form, Spectrum, Turn, transverse_pairs};
 pub use tape::{Block, Kernel, Recorder, Tape};
 
 /// serde, for the code `#[derive(OperatorSpec)]` generates.

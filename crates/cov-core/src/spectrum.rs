@@ -254,15 +254,25 @@ pub trait Spectrum: fmt::Debug {
     /// [`CovError::MissingAxis`] in flatland (N = 2, 3); non-finite `angle`.
     #[inline(always)]
     fn rotate_frame(&mut self, angle: f64) -> Result<(), CovError> {
-        CovError::require_finite("rotate_frame", "angle", angle)?;
+        self.rotate_frame_by(Turn::new("rotate_frame", "angle", angle)?)
+    }
+
+    /// [`Spectrum::rotate_frame`] by a [`Turn`], whose cosine and sine were computed when
+    /// it was built: an operator that turns the frame by a fixed angle builds its `Turn`
+    /// once and pays no trigonometry per application. The same result bits as
+    /// `rotate_frame(turn.angle())`.
+    ///
+    /// # Errors
+    /// [`CovError::MissingAxis`] in flatland (N = 2, 3).
+    #[inline(always)]
+    fn rotate_frame_by(&mut self, turn: Turn) -> Result<(), CovError> {
         let (x, y, u, v) = (
             self.index(Axis::X)?,
             self.index(Axis::Y)?,
             self.index(Axis::U)?,
             self.index(Axis::V)?,
         );
-        let (s, c) = angle.sin_cos();
-        self.raw_rotate("rotate_frame", &[(x, y), (u, v)], c, s)
+        self.raw_rotate("rotate_frame", &[(x, y), (u, v)], turn.cos, turn.sin)
     }
 
     /// Rule 2 on one axis: multiplying the primal by a window adds its spectrum variance,
@@ -464,4 +474,72 @@ pub(crate) fn two_axes(n: usize, op: &str, a: Axis, b: Axis) -> Result<(usize, u
         });
     }
     Ok((i, j))
+}
+
+/// A rotation of the tangent frame by a finite angle (radians), with its cosine and sine
+/// computed once, when it is built ([`Spectrum::rotate_frame_by`]). Operators that turn
+/// the frame by a parameter (a projection, a principal curvature frame, a reflection's
+/// turn) hold one, so their per-application cost has no trigonometry.
+///
+/// ```
+/// use cov_core::{Cov, Spectrum, Turn};
+/// let turn = Turn::new("MyOperator", "angle", 0.3)?;
+/// let (mut a, mut b) = (Cov::<4>::from_diagonal([1.0, 2.0, 3.0, 4.0])?, Cov::<4>::from_diagonal([1.0, 2.0, 3.0, 4.0])?);
+/// a.rotate_frame_by(turn)?;
+/// b.rotate_frame(0.3)?;
+/// assert_eq!(a, b); // the same bits
+/// // A non-finite angle names the operator and parameter it came from.
+/// let err = Turn::new("MyOperator", "angle", f64::NAN).unwrap_err().to_string();
+/// assert!(err.contains("MyOperator") && err.contains("angle"));
+/// # Ok::<(), cov_core::CovError>(())
+/// ```
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Turn {
+    angle: f64,
+    cos: f64,
+    sin: f64,
+}
+
+impl Turn {
+    /// No rotation.
+    pub const ZERO: Turn = Turn {
+        angle: 0.0,
+        cos: 1.0,
+        sin: 0.0,
+    };
+
+    /// The rotation by `angle` (radians); `operator` and `parameter` name the angle in
+    /// the error.
+    ///
+    /// # Errors
+    /// [`CovError::NonFinite`] for a non-finite `angle`.
+    #[inline]
+    pub fn new(operator: &str, parameter: &str, angle: f64) -> Result<Turn, CovError> {
+        let angle = CovError::require_finite(operator, parameter, angle)?;
+        if angle == 0.0 {
+            // The common "no turn": `sin_cos(±0)` is exactly (±0, 1), without the call.
+            return Ok(Turn {
+                angle,
+                cos: 1.0,
+                sin: angle,
+            });
+        }
+        let (sin, cos) = angle.sin_cos();
+        Ok(Turn { angle, cos, sin })
+    }
+
+    /// The angle (radians).
+    pub fn angle(&self) -> f64 {
+        self.angle
+    }
+
+    /// `cos(angle)`.
+    pub fn cos(&self) -> f64 {
+        self.cos
+    }
+
+    /// `sin(angle)`.
+    pub fn sin(&self) -> f64 {
+        self.sin
+    }
 }

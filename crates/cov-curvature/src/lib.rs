@@ -58,14 +58,16 @@
 
 pub mod spec;
 
-use cov_core::{Axis, AxisSet, CovError, Operator, Spectrum};
+use cov_core::{Axis, AxisSet, CovError, Operator, Spectrum, Turn};
 
 /// Curvature by principal curvatures and direction.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Curvature {
     kx: f64,
     ky: f64,
-    angle: f64,
+    /// Into the principal frame, and back (each with its trigonometry done once).
+    turn: Turn,
+    back: Turn,
 }
 
 impl Curvature {
@@ -91,7 +93,8 @@ impl Curvature {
         Ok(Curvature {
             kx: CovError::require_finite(Self::NAME, "kx", kx)?,
             ky: CovError::require_finite(Self::NAME, "ky", ky)?,
-            angle: CovError::require_finite(Self::NAME, "angle", angle)?,
+            turn: Turn::new(Self::NAME, "angle", angle)?,
+            back: Turn::new(Self::NAME, "angle", -angle)?,
         })
     }
 
@@ -100,13 +103,14 @@ impl Curvature {
         Curvature {
             kx: -self.kx,
             ky: -self.ky,
-            angle: self.angle,
+            turn: self.turn,
+            back: self.back,
         }
     }
 
     /// The tensor `K = R(α) diag(kx, ky) R(α)ᵀ` in the frame: `(kxx, kxy, kyy)`.
     pub fn tensor(&self) -> (f64, f64, f64) {
-        let (s, c) = self.angle.sin_cos();
+        let (s, c) = (self.turn.sin(), self.turn.cos());
         (
             c * c * self.kx + s * s * self.ky,
             c * s * (self.kx - self.ky),
@@ -165,7 +169,7 @@ impl Curvature {
     ///
     /// # Errors
     /// As [`Operator::apply`].
-    #[inline]
+    #[inline(always)]
     pub fn apply_to<S: Spectrum + ?Sized>(&self, cov: &mut S) -> Result<(), CovError> {
         if self.is_isotropic() {
             for &(p, d) in cov.transverse_pairs() {
@@ -181,10 +185,10 @@ impl Curvature {
     #[inline(never)]
     fn apply_principal<S: Spectrum + ?Sized>(&self, cov: &mut S) -> Result<(), CovError> {
         // Principal frame: rotate, shear each pair by its curvature, rotate back.
-        cov.rotate_frame(self.angle)?;
+        cov.rotate_frame_by(self.turn)?;
         cov.shear(Axis::U, Axis::X, self.kx)?;
         cov.shear(Axis::V, Axis::Y, self.ky)?;
-        cov.rotate_frame(-self.angle)
+        cov.rotate_frame_by(self.back)
     }
 }
 
@@ -233,7 +237,7 @@ impl CurvatureTensor {
     ///
     /// # Errors
     /// As [`Operator::apply`].
-    #[inline]
+    #[inline(always)]
     pub fn apply_to<S: Spectrum + ?Sized>(&self, cov: &mut S) -> Result<(), CovError> {
         let [kxx, kxy, kyy] = self.k;
         cov.shear(Axis::U, Axis::X, kxx)?;

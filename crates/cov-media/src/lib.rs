@@ -88,7 +88,7 @@ pub mod spec;
 
 use std::f64::consts::{FRAC_PI_2, PI};
 
-use cov_core::{Axis, AxisSet, CovError, FOUR_PI_SQ, Operator, Spectrum};
+use cov_core::{Axis, AxisSet, CovError, FOUR_PI_SQ, Operator, Spectrum, Turn};
 
 /// Absorption over a segment of a heterogeneous medium, as a window at its start.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -353,7 +353,7 @@ pub enum Fit {
 #[derive(Clone, Debug, PartialEq)]
 pub struct Scatter {
     cos: f64,
-    azimuth: f64,
+    azimuth: Turn,
     var: [f64; 2],
 }
 
@@ -371,7 +371,7 @@ impl Scatter {
             |a| (0.0..=PI).contains(&a),
             "must be in [0, π]",
         )?;
-        CovError::require_finite(Self::NAME, "azimuth", azimuth)?;
+        let azimuth = Turn::new(Self::NAME, "azimuth", azimuth)?;
         let phase = phase.validated()?;
         let var = match fit {
             Fit::Curvature => {
@@ -399,8 +399,8 @@ impl Scatter {
 
 impl Operator for Scatter {
     fn apply(&self, cov: &mut dyn Spectrum) -> Result<(), CovError> {
-        if self.azimuth != 0.0 {
-            cov.rotate_frame(self.azimuth)?;
+        if self.azimuth.angle() != 0.0 {
+            cov.rotate_frame_by(self.azimuth)?;
         }
         cov.scale(Axis::X, self.cos)?;
         for (&axis, var) in cov.direction_axes().iter().zip(self.var) {
@@ -415,7 +415,7 @@ impl Operator for Scatter {
         Ok(())
     }
     fn requires(&self) -> AxisSet {
-        if self.azimuth != 0.0 {
+        if self.azimuth.angle() != 0.0 {
             AxisSet::SPACE
         } else {
             AxisSet::FLAT

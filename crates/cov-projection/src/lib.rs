@@ -63,7 +63,7 @@
 
 pub mod spec;
 
-use cov_core::{Axis, AxisSet, CovError, Operator, Spectrum};
+use cov_core::{Axis, AxisSet, CovError, Operator, Spectrum, Turn};
 use glam::DVec3;
 
 #[inline]
@@ -71,10 +71,11 @@ fn check_cos(op: &str, c: f64) -> Result<f64, CovError> {
     CovError::require_range(op, "cos", c, |c| c > 0.0 && c <= 1.0, "must be in (0, 1]")
 }
 
+/// The frame turn of a projection: none at 0, so a flatland layout accepts it.
 #[inline(always)]
-fn rotate<S: Spectrum + ?Sized>(cov: &mut S, angle: f64) -> Result<(), CovError> {
-    if angle != 0.0 {
-        cov.rotate_frame(angle)
+fn rotate<S: Spectrum + ?Sized>(cov: &mut S, turn: Turn) -> Result<(), CovError> {
+    if turn.angle() != 0.0 {
+        cov.rotate_frame_by(turn)
     } else {
         Ok(())
     }
@@ -92,7 +93,7 @@ fn needs(angle: f64) -> AxisSet {
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Project {
     cos: f64,
-    angle: f64,
+    turn: Turn,
 }
 
 impl Project {
@@ -116,7 +117,7 @@ impl Project {
     pub fn with_angle(cos: f64, angle: f64) -> Result<Self, CovError> {
         Ok(Project {
             cos: check_cos(Self::NAME, cos)?,
-            angle: CovError::require_finite(Self::NAME, "angle", angle)?,
+            turn: Turn::new(Self::NAME, "angle", angle)?,
         })
     }
 
@@ -165,7 +166,7 @@ impl Project {
 
     /// Frame rotation (rad).
     pub fn angle(&self) -> f64 {
-        self.angle
+        self.turn.angle()
     }
 }
 
@@ -176,9 +177,9 @@ impl Project {
     ///
     /// # Errors
     /// As [`Operator::apply`].
-    #[inline]
+    #[inline(always)]
     pub fn apply_to<S: Spectrum + ?Sized>(&self, cov: &mut S) -> Result<(), CovError> {
-        rotate(cov, self.angle)?;
+        rotate(cov, self.turn)?;
         cov.scale(Axis::X, self.cos)
     }
 }
@@ -188,7 +189,7 @@ impl Operator for Project {
         self.apply_to(cov)
     }
     fn requires(&self) -> AxisSet {
-        needs(self.angle)
+        needs(self.turn.angle())
     }
 }
 
@@ -196,7 +197,7 @@ impl Operator for Project {
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Unproject {
     cos: f64,
-    angle: f64,
+    turn: Turn,
 }
 
 impl Unproject {
@@ -223,7 +224,7 @@ impl Unproject {
     pub fn with_angle(cos: f64, angle: f64) -> Result<Self, CovError> {
         Ok(Unproject {
             cos: check_cos(Self::NAME, cos)?,
-            angle: CovError::require_finite(Self::NAME, "angle", angle)?,
+            turn: Turn::new(Self::NAME, "angle", angle)?,
         })
     }
 }
@@ -235,10 +236,10 @@ impl Unproject {
     ///
     /// # Errors
     /// As [`Operator::apply`].
-    #[inline]
+    #[inline(always)]
     pub fn apply_to<S: Spectrum + ?Sized>(&self, cov: &mut S) -> Result<(), CovError> {
         cov.scale(Axis::X, 1.0 / self.cos)?;
-        rotate(cov, self.angle)
+        rotate(cov, self.turn)
     }
 }
 
@@ -247,7 +248,7 @@ impl Operator for Unproject {
         self.apply_to(cov)
     }
     fn requires(&self) -> AxisSet {
-        needs(self.angle)
+        needs(self.turn.angle())
     }
 }
 
@@ -267,7 +268,7 @@ impl Mirror {
     ///
     /// # Errors
     /// As [`Operator::apply`].
-    #[inline]
+    #[inline(always)]
     pub fn apply_to<S: Spectrum + ?Sized>(&self, cov: &mut S) -> Result<(), CovError> {
         // Per axis, not a loop over `direction_axes`: constant axes for a known type.
         cov.scale(Axis::U, -1.0)?;
@@ -287,7 +288,7 @@ impl Operator for Mirror {
 /// Rotation of the tangent frame by `angle` (rad), `(x,y)` and `(u,v)` together.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct RotateFrame {
-    angle: f64,
+    turn: Turn,
 }
 
 impl RotateFrame {
@@ -299,7 +300,7 @@ impl RotateFrame {
     #[inline]
     pub fn new(angle: f64) -> Result<Self, CovError> {
         Ok(RotateFrame {
-            angle: CovError::require_finite(Self::NAME, "angle", angle)?,
+            turn: Turn::new(Self::NAME, "angle", angle)?,
         })
     }
 }
@@ -311,9 +312,9 @@ impl RotateFrame {
     ///
     /// # Errors
     /// As [`Operator::apply`].
-    #[inline]
+    #[inline(always)]
     pub fn apply_to<S: Spectrum + ?Sized>(&self, cov: &mut S) -> Result<(), CovError> {
-        cov.rotate_frame(self.angle)
+        cov.rotate_frame_by(self.turn)
     }
 }
 

@@ -1,6 +1,7 @@
 //! The 10-operator bounce chain of `benches/chain.rs` on 4,096 states (`mode` picks what
 //! runs; each `*-none` mode is the same loop without the chain). At N = 4 with fixed
-//! parameters: the baseline, `Chain::apply` in both forms. With per-state parameters
+//! parameters: the baseline, `Chain::apply` in both forms, and `eval_batch_typed` with
+//! the operators built once and shared (`fixed-typed`). With per-state parameters
 //! (each state's operators built for it) at N = 2, 4, 5: `eval_batch_with` (a closure
 //! over `dyn Spectrum`) and `eval_batch_typed` (`StateOps`, the operators' typed bodies),
 //! covariance form. Run under `valgrind --tool=callgrind` by `count.sh` (one rayon
@@ -47,6 +48,16 @@ struct PerState(usize);
 impl StateOps for PerState {
     fn apply<S: Spectrum>(&self, i: usize, s: &mut S) -> Result<(), CovError> {
         Ops::new(&ray(i), self.0).try_typed(s)
+    }
+}
+
+/// One ray's operators shared by every state, for `eval_batch_typed` (the fixed chain
+/// through the operators' typed bodies, no tape).
+struct Shared(Ops);
+
+impl StateOps for Shared {
+    fn apply<S: Spectrum>(&self, _: usize, s: &mut S) -> Result<(), CovError> {
+        self.0.try_typed(s)
     }
 }
 
@@ -101,6 +112,14 @@ fn main() {
             let start: Vec<CovFactor<4>> = covs::<4>().iter().map(CovFactor::from_cov).collect();
             chain_over(&start, run);
         }
+        "fixed-typed" | "fixed-typed-none" => {
+            let ops = Shared(Ops::new(&ray(0), 4));
+            let mut s = covs::<4>();
+            if run {
+                assert!(covtrace::eval_batch_typed(Form::Covariance, &mut s, &ops).is_empty());
+            }
+            black_box(&s);
+        }
         "base" | "base-none" => {
             let fixed = baseline::Fixed::new(&ray(0));
             let mut s: Vec<baseline::Packed<4>> = covs::<4>()
@@ -128,7 +147,7 @@ fn main() {
         }
         _ => {
             eprintln!(
-                "usage: chain-probe base|cov|sqrt|with-2|typed-2|with-4|typed-4|with-5|typed-5 (or its -none loop)"
+                "usage: chain-probe base|cov|sqrt|fixed-typed|with-2|typed-2|with-4|typed-4|with-5|typed-5 (or its -none loop)"
             );
             std::process::exit(2);
         }
