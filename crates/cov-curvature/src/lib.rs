@@ -169,7 +169,7 @@ impl Curvature {
     ///
     /// # Errors
     /// As [`Operator::apply`].
-    #[inline(always)]
+    #[inline]
     pub fn apply_to<S: Spectrum + ?Sized>(&self, cov: &mut S) -> Result<(), CovError> {
         if self.is_isotropic() {
             for &(p, d) in cov.transverse_pairs() {
@@ -237,7 +237,7 @@ impl CurvatureTensor {
     ///
     /// # Errors
     /// As [`Operator::apply`].
-    #[inline(always)]
+    #[inline]
     pub fn apply_to<S: Spectrum + ?Sized>(&self, cov: &mut S) -> Result<(), CovError> {
         let [kxx, kxy, kyy] = self.k;
         cov.shear(Axis::U, Axis::X, kxx)?;

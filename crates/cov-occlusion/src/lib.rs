@@ -126,7 +126,7 @@ impl Window {
     ///
     /// # Errors
     /// As [`Operator::apply`].
-    #[inline(always)]
+    #[inline]
     pub fn apply_to<S: Spectrum + ?Sized>(&self, cov: &mut S) -> Result<(), CovError> {
         cov.add_variance(Axis::X, self.wx)?;
         if cov.has(Axis::Y) {

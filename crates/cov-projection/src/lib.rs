@@ -177,7 +177,7 @@ impl Project {
     ///
     /// # Errors
     /// As [`Operator::apply`].
-    #[inline(always)]
+    #[inline]
     pub fn apply_to<S: Spectrum + ?Sized>(&self, cov: &mut S) -> Result<(), CovError> {
         rotate(cov, self.turn)?;
         cov.scale(Axis::X, self.cos)
@@ -236,7 +236,7 @@ impl Unproject {
     ///
     /// # Errors
     /// As [`Operator::apply`].
-    #[inline(always)]
+    #[inline]
     pub fn apply_to<S: Spectrum + ?Sized>(&self, cov: &mut S) -> Result<(), CovError> {
         cov.scale(Axis::X, 1.0 / self.cos)?;
         rotate(cov, self.turn)
@@ -268,7 +268,7 @@ impl Mirror {
     ///
     /// # Errors
     /// As [`Operator::apply`].
-    #[inline(always)]
+    #[inline]
     pub fn apply_to<S: Spectrum + ?Sized>(&self, cov: &mut S) -> Result<(), CovError> {
         // Per axis, not a loop over `direction_axes`: constant axes for a known type.
         cov.scale(Axis::U, -1.0)?;
@@ -312,7 +312,7 @@ impl RotateFrame {
     ///
     /// # Errors
     /// As [`Operator::apply`].
-    #[inline(always)]
+    #[inline]
     pub fn apply_to<S: Spectrum + ?Sized>(&self, cov: &mut S) -> Result<(), CovError> {
         cov.rotate_frame_by(self.turn)
     }

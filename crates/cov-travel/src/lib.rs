@@ -91,7 +91,7 @@ impl Travel {
     ///
     /// # Errors
     /// As [`Operator::apply`].
-    #[inline(always)]
+    #[inline]
     pub fn apply_to<S: Spectrum + ?Sized>(&self, cov: &mut S) -> Result<(), CovError> {
         for &(p, d) in cov.transverse_pairs() {
             cov.shear(p, d, -self.distance)?;

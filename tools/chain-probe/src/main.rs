@@ -120,6 +120,27 @@ fn main() {
             }
             black_box(&s);
         }
+        "ray-typed" | "ray-typed-none" | "ray-dyn" | "ray-dyn-none" => {
+            let typed = mode.starts_with("ray-typed");
+            let mut s = covs::<4>();
+            // CHAIN_PROBE_REPS repeats the loop, for timing outside callgrind.
+            let reps: usize = std::env::var("CHAIN_PROBE_REPS")
+                .ok()
+                .and_then(|r| r.parse().ok())
+                .unwrap_or(1);
+            let start = s.clone();
+            for _ in 0..reps {
+                s.copy_from_slice(&start);
+                if run {
+                    for (i, c) in s.iter_mut().enumerate() {
+                        let ops = Ops::new(&ray(i), 4);
+                        black_box(if typed { ops.apply_typed(c) } else { ops.apply(c) });
+                    }
+                }
+                black_box(&s);
+            }
+            black_box(&s);
+        }
         "base" | "base-none" => {
             let fixed = baseline::Fixed::new(&ray(0));
             let mut s: Vec<baseline::Packed<4>> = covs::<4>()
