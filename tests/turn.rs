@@ -117,11 +117,18 @@ proptest! {
 
 #[test]
 fn turn_is_rotate_frame_and_names_its_parameter() {
-    for angle in [0.0, -0.0, 0.3, -2.5, 1e-300, 1e12] {
+    for angle in [0.0, -0.0, 0.3, -2.5, 1e-300, 1e12, 1e300, 3.0e-8, 710.5] {
         let t = Turn::new("Op", "angle", angle).expect("finite");
         let (s, c) = angle.sin_cos();
         assert_eq!((t.sin().to_bits(), t.cos().to_bits()), (s.to_bits(), c.to_bits()));
         assert_eq!(t.angle().to_bits(), angle.to_bits());
+        // The way back without trigonometry: `sin` odd to the bit.
+        let back = Turn::new("Op", "angle", -angle).expect("finite");
+        let inv = t.inverse();
+        assert_eq!(
+            (inv.sin().to_bits(), inv.cos().to_bits()),
+            (back.sin().to_bits(), back.cos().to_bits())
+        );
     }
     assert_eq!(Turn::ZERO, Turn::new("Op", "angle", 0.0).expect("finite"));
     for bad in [f64::NAN, f64::INFINITY, f64::NEG_INFINITY] {

@@ -211,7 +211,7 @@ impl Lobe {
     ///
     /// # Errors
     /// Overflow.
-    #[inline]
+    #[inline(always)]
     pub fn apply_to<S: Spectrum + ?Sized>(&self, cov: &mut S) -> Result<(), CovError> {
         let (vu, vv) = self.variances();
         // Written out per axis (not a loop over `direction_axes`), so that a caller that
@@ -268,7 +268,7 @@ impl Brdf {
     ///
     /// # Errors
     /// As [`Operator::apply`].
-    #[inline]
+    #[inline(always)]
     pub fn apply_to<S: Spectrum + ?Sized>(&self, cov: &mut S) -> Result<(), CovError> {
         self.lobe.apply_to(cov)
     }

@@ -528,6 +528,17 @@ impl Turn {
         Ok(Turn { angle, cos, sin })
     }
 
+    /// The rotation back, by `-angle`: `(cos, -sin)`, without trigonometry. The same
+    /// bits as `Turn::new(.., -angle)` wherever `sin` is odd to the bit, as glibc's is
+    /// (`tests/turn.rs` checks it through the operators that use it).
+    pub fn inverse(&self) -> Turn {
+        Turn {
+            angle: -self.angle,
+            cos: self.cos,
+            sin: -self.sin,
+        }
+    }
+
     /// The angle (radians).
     pub fn angle(&self) -> f64 {
         self.angle

@@ -65,9 +65,8 @@ use cov_core::{Axis, AxisSet, CovError, Operator, Spectrum, Turn};
 pub struct Curvature {
     kx: f64,
     ky: f64,
-    /// Into the principal frame, and back (each with its trigonometry done once).
+    /// Into the principal frame (its trigonometry done once; back is its inverse).
     turn: Turn,
-    back: Turn,
 }
 
 impl Curvature {
@@ -94,7 +93,6 @@ impl Curvature {
             kx: CovError::require_finite(Self::NAME, "kx", kx)?,
             ky: CovError::require_finite(Self::NAME, "ky", ky)?,
             turn: Turn::new(Self::NAME, "angle", angle)?,
-            back: Turn::new(Self::NAME, "angle", -angle)?,
         })
     }
 
@@ -104,7 +102,6 @@ impl Curvature {
             kx: -self.kx,
             ky: -self.ky,
             turn: self.turn,
-            back: self.back,
         }
     }
 
@@ -188,7 +185,7 @@ impl Curvature {
         cov.rotate_frame_by(self.turn)?;
         cov.shear(Axis::U, Axis::X, self.kx)?;
         cov.shear(Axis::V, Axis::Y, self.ky)?;
-        cov.rotate_frame_by(self.back)
+        cov.rotate_frame_by(self.turn.inverse())
     }
 }
 

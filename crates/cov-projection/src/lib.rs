@@ -177,7 +177,7 @@ impl Project {
     ///
     /// # Errors
     /// As [`Operator::apply`].
-    #[inline]
+    #[inline(always)]
     pub fn apply_to<S: Spectrum + ?Sized>(&self, cov: &mut S) -> Result<(), CovError> {
         rotate(cov, self.turn)?;
         cov.scale(Axis::X, self.cos)
@@ -236,7 +236,7 @@ impl Unproject {
     ///
     /// # Errors
     /// As [`Operator::apply`].
-    #[inline]
+    #[inline(always)]
     pub fn apply_to<S: Spectrum + ?Sized>(&self, cov: &mut S) -> Result<(), CovError> {
         cov.scale(Axis::X, 1.0 / self.cos)?;
         rotate(cov, self.turn)

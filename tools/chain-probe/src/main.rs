@@ -76,6 +76,14 @@ fn covs<const N: usize>() -> Vec<Cov<N>> {
 /// `eval_batch_with` (`typed` false) or `eval_batch_typed` over 4,096 states of layout `N`.
 fn per_state<const N: usize>(run: bool, typed: bool) {
     let mut s = covs::<N>();
+    // CHAIN_PROBE_REPS runs the batch again (the states keep evolving), for timing.
+    let reps: usize = std::env::var("CHAIN_PROBE_REPS")
+        .ok()
+        .and_then(|r| r.parse().ok())
+        .unwrap_or(1);
+    for _ in 1..reps {
+        let _ = covtrace::eval_batch_typed(Form::Covariance, &mut s, &PerState(N));
+    }
     if run {
         let failed = if typed {
             covtrace::eval_batch_typed(Form::Covariance, &mut s, &PerState(N))
