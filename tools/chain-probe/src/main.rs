@@ -81,8 +81,12 @@ fn per_state<const N: usize>(run: bool, typed: bool) {
         .ok()
         .and_then(|r| r.parse().ok())
         .unwrap_or(1);
+    let mut failed = 0;
     for _ in 1..reps {
-        let _ = covtrace::eval_batch_typed(Form::Covariance, &mut s, &PerState(N));
+        failed += covtrace::eval_batch_typed(Form::Covariance, &mut s, &PerState(N)).len();
+    }
+    if failed > 0 {
+        eprintln!("{failed} states failed over {reps} repetitions");
     }
     if run {
         let failed = if typed {
