@@ -41,7 +41,7 @@ mod common;
 mod ops;
 use baseline::{Fixed, Packed, Ray};
 use common::{BATCH, random_covs};
-use ops::Ops;
+use ops::{Ops, Shared};
 
 fn unit(rng: &mut ChaCha8Rng) -> DVec3 {
     loop {
@@ -93,17 +93,6 @@ impl StateOps for PerRay<'_> {
     #[inline(always)]
     fn apply<S: Spectrum>(&self, i: usize, s: &mut S) -> Result<(), CovError> {
         Ops::new(&self.rays[i % self.rays.len()], self.n).try_typed(s)
-    }
-}
-
-/// One ray's operators, built once and shared by every state, through their typed
-/// bodies: the fixed chain as a Rust caller that knows its operators writes it.
-struct Shared(Ops);
-
-impl StateOps for Shared {
-    #[inline(always)]
-    fn apply<S: Spectrum>(&self, _: usize, s: &mut S) -> Result<(), CovError> {
-        self.0.try_typed(s)
     }
 }
 

@@ -9,7 +9,7 @@ use covtrace::curvature::Curvature;
 use covtrace::occlusion::Window;
 use covtrace::projection::{Mirror, Project, RotateFrame, Unproject};
 use covtrace::travel::Travel;
-use covtrace::{Chain, CovError, Operator, Spectrum};
+use covtrace::{Chain, CovError, Operator, Spectrum, StateOps};
 use glam::DVec3;
 
 use crate::baseline::Ray;
@@ -119,5 +119,17 @@ impl Ops {
         c.push(self.t2);
         c.push(self.window);
         c
+    }
+}
+
+/// One ray's operators, built once and shared by every state of `eval_batch_typed`,
+/// through their typed bodies: the fixed chain without a tape, as a Rust caller that
+/// knows its operators writes it.
+pub struct Shared(pub Ops);
+
+impl StateOps for Shared {
+    #[inline(always)]
+    fn apply<S: Spectrum>(&self, _: usize, s: &mut S) -> Result<(), CovError> {
+        self.0.try_typed(s)
     }
 }

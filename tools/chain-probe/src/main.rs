@@ -19,7 +19,7 @@ mod baseline;
 mod ops;
 
 use baseline::Ray;
-use ops::Ops;
+use ops::{Ops, Shared};
 
 const STATES: usize = 4096;
 
@@ -51,14 +51,13 @@ impl StateOps for PerState {
     }
 }
 
-/// One ray's operators shared by every state, for `eval_batch_typed` (the fixed chain
-/// through the operators' typed bodies, no tape).
-struct Shared(Ops);
-
-impl StateOps for Shared {
-    fn apply<S: Spectrum>(&self, _: usize, s: &mut S) -> Result<(), CovError> {
-        self.0.try_typed(s)
-    }
+/// `CHAIN_PROBE_REPS` (default 1): how many times a timed mode runs its loop, for
+/// wall-clock timing outside callgrind.
+fn reps() -> usize {
+    std::env::var("CHAIN_PROBE_REPS")
+        .ok()
+        .and_then(|r| r.parse().ok())
+        .unwrap_or(1)
 }
 
 fn covs<const N: usize>() -> Vec<Cov<N>> {
@@ -76,25 +75,22 @@ fn covs<const N: usize>() -> Vec<Cov<N>> {
 /// `eval_batch_with` (`typed` false) or `eval_batch_typed` over 4,096 states of layout `N`.
 fn per_state<const N: usize>(run: bool, typed: bool) {
     let mut s = covs::<N>();
-    // CHAIN_PROBE_REPS runs the batch again (the states keep evolving), for timing.
-    let reps: usize = std::env::var("CHAIN_PROBE_REPS")
-        .ok()
-        .and_then(|r| r.parse().ok())
-        .unwrap_or(1);
-    let mut failed = 0;
-    for _ in 1..reps {
-        failed += covtrace::eval_batch_typed(Form::Covariance, &mut s, &PerState(N)).len();
-    }
+    let batch = |s: &mut [Cov<N>]| {
+        if typed {
+            covtrace::eval_batch_typed(Form::Covariance, s, &PerState(N))
+        } else {
+            covtrace::eval_batch_with(Form::Covariance, s, |i, c| Ops::new(&ray(i), N).try_dyn(c))
+        }
+    };
+    // Extra repetitions (CHAIN_PROBE_REPS) run on the evolving states; a failure would
+    // time the checked re-run instead of the fast path, so it is reported.
+    let reps = reps();
+    let failed: usize = (1..reps).map(|_| batch(&mut s).len()).sum();
     if failed > 0 {
         eprintln!("{failed} states failed over {reps} repetitions");
     }
     if run {
-        let failed = if typed {
-            covtrace::eval_batch_typed(Form::Covariance, &mut s, &PerState(N))
-        } else {
-            covtrace::eval_batch_with(Form::Covariance, &mut s, |i, c| Ops::new(&ray(i), N).try_dyn(c))
-        };
-        assert!(failed.is_empty());
+        assert!(batch(&mut s).is_empty());
     }
     black_box(&s);
 }
@@ -135,13 +131,8 @@ fn main() {
         "ray-typed" | "ray-typed-none" | "ray-dyn" | "ray-dyn-none" => {
             let typed = mode.starts_with("ray-typed");
             let mut s = covs::<4>();
-            // CHAIN_PROBE_REPS repeats the loop, for timing outside callgrind.
-            let reps: usize = std::env::var("CHAIN_PROBE_REPS")
-                .ok()
-                .and_then(|r| r.parse().ok())
-                .unwrap_or(1);
             let start = s.clone();
-            for _ in 0..reps {
+            for _ in 0..reps() {
                 s.copy_from_slice(&start);
                 if run {
                     for (i, c) in s.iter_mut().enumerate() {
