@@ -1,6 +1,6 @@
 //! # cov-brdf: reflectance lobes and reflection at a curved surface
 //!
-//! **Primal definition** (PHYSICS.md section 3): a BRDF lobe `ρ` convolves the light field
+//! **Primal definition** (docs/physics.md section 3): a BRDF lobe `ρ` convolves the light field
 //! in angle, `l'(x,u) = ∫ l(x,u') ρ(u − u') du'`. By rule 3, with `S` the spectrum
 //! covariance of `ρ` on the direction axes, `Σ' = Σ − Σ Pᵀ (S + PΣPᵀ)⁻¹ P Σ` (computed by
 //! cov-core without inverting Σ). A Gaussian lobe of variance `var` (tangent units²) has

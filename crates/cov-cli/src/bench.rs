@@ -11,11 +11,14 @@
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
-use cov_render::bench::{Guide, Method, Run, error, fit_loglog, run, speedup};
-use cov_render::render::{
-    STRIDES, covariance_maps_strided, read_image, render_adaptive, tile_count, timed, tonemap, write_image,
-};
-use cov_render::{MAX_SPP, World};
+use cov_render::adaptive::Guide;
+use cov_render::bench::{fit_loglog, speedup};
+use cov_render::covpass::STRIDES;
+use cov_render::film::tile_count;
+use cov_render::metrics::measure;
+use cov_render::output::{read_image, tonemap, write_image};
+use cov_render::renderer::timed;
+use cov_render::{MAX_SPP, Method, RenderSettings, Rendered, Renderer, World};
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
@@ -93,8 +96,8 @@ pub struct Row {
 }
 
 impl Row {
-    fn new(r: &Run, reference: &cov_render::Image) -> Result<Row, String> {
-        let e = error(&r.image, reference)?;
+    fn new(r: &Rendered, reference: &cov_render::Image) -> Result<Row, String> {
+        let e = measure(&r.image, reference).map_err(|e| e.to_string())?;
         Ok(Row {
             method: r.method.name(),
             budget: r.budget,
@@ -126,13 +129,7 @@ fn methods(names: &[String]) -> Result<Vec<Method>, String> {
     }
     let mut out = Vec::new();
     for n in names {
-        let m = Method::from_name(n.trim()).ok_or_else(|| {
-            format!(
-                "--methods: unknown method `{}` (one of: {})",
-                cov_render::echo(n),
-                Method::ALL.map(Method::name).join(", ")
-            )
-        })?;
+        let m = crate::render::parse_method(n).map_err(|e| format!("--methods: {e}"))?;
         if !out.contains(&m) {
             out.push(m);
         }
@@ -205,17 +202,16 @@ fn reference(
         return Ok((img, format!("reference: {} (cached)", exr.display())));
     }
     let b = bar(tile_count(world), "reference");
-    let counts = vec![a.ref_spp; w as usize * h as usize];
-    let ((img, _), secs) = timed(|| {
-        render_adaptive(
-            world,
-            &counts,
-            a.seed.wrapping_add(0x5eed_0000_0000),
-            Some(&|| b.inc(1)),
-        )
-    });
+    let settings = RenderSettings {
+        method: Method::Uniform,
+        spp: f64::from(a.ref_spp),
+        seed: a.seed.wrapping_add(0x5eed_0000_0000),
+        ..RenderSettings::default()
+    };
+    let (img, secs) = timed(|| Renderer::new(world, settings)?.render(Some(&|| b.inc(1))));
     b.finish_and_clear();
-    write_image(&img, &exr, &exr.with_extension("png"))?;
+    let img = img.map_err(|e| e.to_string())?.image;
+    write_image(&img, &exr, &exr.with_extension("png")).map_err(|e| e.to_string())?;
     Ok((
         img,
         format!(
@@ -236,12 +232,12 @@ pub fn bench(a: &BenchArgs) -> Result<String, String> {
     folder(&a.output, "output folder")?;
     let cache = a.cache.clone().unwrap_or_else(|| a.output.clone());
     folder(&cache, "cache folder")?;
-    let mut world = World::load(&a.scene).map_err(|e| e.to_string())?;
-    if let Some((w, h)) = a.size {
-        world = world.with_resolution(w, h);
-    }
+    let world = crate::render::load(&a.scene, a.size)?;
     let (w, h) = (world.camera.width, world.camera.height);
-    let mut out = format!("scene: {} ({w}×{h} px)\n", a.scene.display());
+    let mut out = format!(
+        "scene: {} ({w}×{h} px)\n",
+        cov_render::echo(&a.scene.display().to_string())
+    );
     let (reference, line) = reference(a, &world, &text, &cache)?;
     out.push_str(&line);
     out.push('\n');
@@ -249,21 +245,40 @@ pub fn bench(a: &BenchArgs) -> Result<String, String> {
         .save(a.output.join("reference.png"))
         .map_err(|e| format!("{}: {e}", a.output.join("reference.png").display()))?;
 
+    let settings = |method: Method, spp: f64, seed: u64| RenderSettings {
+        method,
+        spp,
+        seed,
+        cov_paths: a.cov_paths,
+        cov_stride: a.cov_stride,
+        ..RenderSettings::default()
+    };
+    // Every run goes through the library's renderer, with the covariance guide traced
+    // here once (its time is added to every covariance run).
+    let run = |m: Method, budget: f64, guide: Option<&Guide>, seed: u64| -> Result<Rendered, String> {
+        let mut r = Renderer::new(&world, settings(m, budget, seed)).map_err(|e| e.to_string())?;
+        if let Some(g) = guide {
+            r = r.with_guide(g.clone()).map_err(|e| e.to_string())?;
+        }
+        r.render(None).map_err(|e| e.to_string())
+    };
     // Warm-up (caches, the thread pool): one uniform pass at 1 spp, not recorded.
-    run(&world, Method::Uniform, 1.0, None, a.seed ^ 0x77, None)?;
+    run(Method::Uniform, 1.0, None, a.seed ^ 0x77)?;
     // The covariance pass, once per repeat (its fastest time is added to every covariance
     // run: the pass does not depend on the budget).
     let guide = if methods.iter().any(|m| m.uses_covariance()) {
         let mut best: Option<Guide> = None;
         for _ in 0..a.repeat {
             let b = bar(tile_count(&world), "covariance");
-            let (maps, secs) = timed(|| {
-                covariance_maps_strided(&world, a.cov_paths, a.cov_stride, a.seed, Some(&|| b.inc(1)))
-            });
+            let mut r =
+                Renderer::new(&world, settings(Method::Cov, 1.0, a.seed)).map_err(|e| e.to_string())?;
+            let traced = r.trace_covariance(Some(&|| b.inc(1))).map(|_| ());
             b.finish_and_clear();
-            let g = Guide::new(&maps?, secs);
-            if best.as_ref().is_none_or(|b| g.secs < b.secs) {
-                best = Some(g);
+            traced.map_err(|e| e.to_string())?;
+            if let Some(g) = r.guide()
+                && best.as_ref().is_none_or(|b| g.secs < b.secs)
+            {
+                best = Some(g.clone());
             }
         }
         if let Some(g) = &best {
@@ -293,11 +308,11 @@ pub fn bench(a: &BenchArgs) -> Result<String, String> {
         for &m in &methods {
             // Repeats use other seeds: the errors are averaged (a low-spp image's error
             // depends on where its rare bright paths fell), the fastest time is kept.
-            let first = run(&world, m, budget, guide.as_ref(), a.seed, None)?;
+            let first = run(m, budget, guide.as_ref(), a.seed)?;
             let mut row = Row::new(&first, &reference)?;
             for k in 1..a.repeat {
                 let seed = a.seed.wrapping_add(u64::from(k) * 1_000_003);
-                let again = Row::new(&run(&world, m, budget, guide.as_ref(), seed, None)?, &reference)?;
+                let again = Row::new(&run(m, budget, guide.as_ref(), seed)?, &reference)?;
                 row.rmse += again.rmse;
                 row.relmse += again.relmse;
                 if again.seconds < row.seconds {
@@ -588,7 +603,7 @@ fn write_strip(
             .min_by(|a, b| (a.2 / target).ln().abs().total_cmp(&(b.2 / target).ln().abs()));
         if let Some((m, budget, secs, img)) = best {
             // This image's own error (the table averages over repeats).
-            let rel = error(img, reference)?.relmse;
+            let rel = measure(img, reference).map_err(|e| e.to_string())?.relmse;
             panels.push((
                 format!("{} · {budget} spp · {secs:.2} s", m.name()),
                 format!("relMSE {rel:.2e}"),
@@ -597,9 +612,10 @@ fn write_strip(
             picked.push(format!("{} {budget} spp", m.name()));
             let dir = path.parent().unwrap_or(Path::new("."));
             let name = dir.join(format!("{}.exr", m.name()));
-            write_image(img, &name, &name.with_extension("png"))?;
+            write_image(img, &name, &name.with_extension("png")).map_err(|e| e.to_string())?;
             let err = dir.join(format!("{}.error.png", m.name()));
-            cov_render::bench::error_map(img, reference)?
+            cov_render::metrics::error_map(img, reference)
+                .map_err(|e| e.to_string())?
                 .save(&err)
                 .map_err(|e| format!("{}: {e}", err.display()))?;
         }

@@ -55,8 +55,9 @@ enum Command {
     /// Check the covariance pass against a reference render: the local spectrum of each
     /// 16×16 tile against the predicted bandwidth.
     RenderCheck(cov_cli::render::CheckArgs),
-    /// Render a scene (RON) with uniform sampling; also writes the covariance pass's
-    /// density and filter maps.
+    /// Render a scene (RON) with covariance tracing (by default; --method picks another
+    /// method): the covariance pass, samples where it predicts detail, per-pixel filters
+    /// from Σ; writes the image (EXR and PNG) and the density and filter maps.
     Render(cov_cli::render::RenderArgs),
     /// Image error against run time: every sampling and reconstruction method (uniform,
     /// Gaussian, variance-driven, covariance-driven) at several budgets against a cached

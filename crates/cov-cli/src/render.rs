@@ -1,11 +1,14 @@
-//! `covtrace render`: a uniform-sampling render of a scene file, with its covariance maps.
+//! `covtrace render`: renders a scene file with covariance tracing (or another method of
+//! [`Method`]) through the library's [`Renderer`], and writes the image and the covariance
+//! maps; `covtrace render-check`: the maps against reference images.
 
 use std::path::{Path, PathBuf};
 
-use cov_render::render::{
-    covariance_maps_with, render_adaptive, render_clamped, tile_count, timed, write_image, write_maps,
-};
-use cov_render::{MAX_COV_PATHS, MAX_SPP, World};
+use cov_render::covpass::{MAX_COV_PATHS, STRIDES};
+use cov_render::film::tile_count;
+use cov_render::output::{write_image, write_maps};
+use cov_render::renderer::{MAX_TIME, timed};
+use cov_render::{MAX_SPP, Method, RenderSettings, Renderer, World};
 use indicatif::{ProgressBar, ProgressStyle};
 
 /// What `covtrace render` was asked (parsed by clap).
@@ -13,21 +16,86 @@ use indicatif::{ProgressBar, ProgressStyle};
 pub struct RenderArgs {
     /// The scene file.
     pub scene: PathBuf,
-    /// Samples per pixel.
+    /// Sampling and reconstruction method: cov (covariance tracing: samples where the
+    /// covariance pass predicts detail, per-pixel filters from Σ), cov-density,
+    /// cov-filter, variance, gauss or uniform (plain Monte Carlo).
+    #[arg(long, default_value = "cov", value_parser = parse_method)]
+    pub method: Method,
+    /// Average samples per pixel (of each pass, with --time).
     #[arg(long, default_value_t = 16)]
     pub spp: u32,
-    /// Output EXR (linear); a PNG and the maps are written beside it.
+    /// Render progressively: passes of --spp over the same per-pixel sequences until
+    /// this many seconds are spent (covariance pass included).
+    #[arg(long)]
+    pub time: Option<f64>,
+    /// Output EXR (linear); a PNG and the covariance maps are written beside it.
     #[arg(short, long, default_value = "render.exr")]
     pub output: PathBuf,
-    /// Covariance paths per pixel (0: skip the covariance pass).
-    #[arg(long, default_value_t = 4)]
+    /// Covariance paths per block of the covariance grid.
+    #[arg(long, default_value_t = 1)]
     pub cov_paths: u32,
+    /// Side of the covariance grid's blocks (px): 1, 2, 4, 8 or 16.
+    #[arg(long, default_value_t = 4)]
+    pub cov_stride: u32,
     /// Seed of the random numbers (the image does not depend on the thread count).
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
     /// Render at this size instead of the scene's (`WIDTHxHEIGHT`, e.g. `640x480`).
     #[arg(long, value_parser = parse_size)]
     pub size: Option<(u32, u32)>,
+}
+
+/// Parses a method name ([`Method::from_name`]).
+///
+/// # Errors
+/// An unknown name, with the known ones.
+pub fn parse_method(s: &str) -> Result<Method, String> {
+    Method::from_name(s.trim()).ok_or_else(|| {
+        format!(
+            "unknown method `{}` (one of: {})",
+            cov_render::echo(s),
+            Method::ALL.map(Method::name).join(", ")
+        )
+    })
+}
+
+/// The render settings of `covtrace render`'s arguments, named as the user wrote them
+/// when out of range.
+///
+/// # Errors
+/// `--spp`, `--time`, `--cov-paths` or `--cov-stride` out of range.
+pub fn settings(a: &RenderArgs) -> Result<RenderSettings, String> {
+    if a.spp == 0 || a.spp > MAX_SPP {
+        return Err(format!("--spp must be 1 to {MAX_SPP}, got {}", a.spp));
+    }
+    if let Some(t) = a.time
+        && !(t.is_finite() && t > 0.0 && t <= MAX_TIME)
+    {
+        return Err(format!(
+            "--time must be more than 0 and at most {MAX_TIME} seconds, got {t}"
+        ));
+    }
+    if !(1..=MAX_COV_PATHS).contains(&a.cov_paths) {
+        return Err(format!(
+            "--cov-paths must be 1 to {MAX_COV_PATHS}, got {}",
+            a.cov_paths
+        ));
+    }
+    if !STRIDES.contains(&a.cov_stride) {
+        return Err(format!(
+            "--cov-stride must be one of {STRIDES:?}, got {}",
+            a.cov_stride
+        ));
+    }
+    Ok(RenderSettings {
+        method: a.method,
+        spp: f64::from(a.spp),
+        seed: a.seed,
+        time: a.time,
+        cov_paths: a.cov_paths,
+        cov_stride: a.cov_stride,
+        max_luminance: f64::INFINITY,
+    })
 }
 
 /// Parses `WIDTHxHEIGHT`.
@@ -114,69 +182,111 @@ pub fn bar(len: usize, what: &str) -> ProgressBar {
     b
 }
 
+/// Loads the scene of `covtrace render`, `render-check` or `render-bench`, at `size` when
+/// given.
+///
+/// # Errors
+/// The scene's own error, one positioned line.
+pub fn load(scene: &Path, size: Option<(u32, u32)>) -> Result<World, String> {
+    let world = World::load(scene).map_err(|e| e.to_string())?;
+    Ok(match size {
+        Some((w, h)) => world.with_resolution(w, h),
+        None => world,
+    })
+}
+
 /// Runs `covtrace render`; returns the lines to print.
 ///
 /// # Errors
 /// A bad scene (one positioned line), bad arguments, unwritable outputs.
 pub fn run(a: &RenderArgs) -> Result<String, String> {
-    if a.spp == 0 || a.spp > MAX_SPP {
-        return Err(format!("--spp must be 1 to {MAX_SPP}, got {}", a.spp));
-    }
-    if a.cov_paths > MAX_COV_PATHS {
-        return Err(format!(
-            "--cov-paths must be 0 to {MAX_COV_PATHS}, got {}",
-            a.cov_paths
-        ));
-    }
+    let settings = settings(a)?;
     check_output(&a.output, "exr")?;
-    let mut world = World::load(&a.scene).map_err(|e| e.to_string())?;
-    if let Some((w, h)) = a.size {
-        world = world.with_resolution(w, h);
-    }
+    let world = load(&a.scene, a.size)?;
     let (w, h) = (world.camera.width, world.camera.height);
     let [png, density, filter, json] = outputs(&a.output);
-    let tiles = tile_count(&world);
     let mut out = format!(
-        "scene: {} ({w}×{h} px, {} primitives, {} lights, covariance layout {})\n",
-        a.scene.display(),
+        "scene: {} ({w}×{h} px, {} primitives, {} lights)\n",
+        cov_render::echo(&a.scene.display().to_string()),
         world.geometry.len(),
         world.lights.len(),
-        if world.has_motion {
-            "5 (x,y,u,v,t)"
-        } else {
-            "4 (x,y,u,v)"
-        }
     );
-    let b = bar(tiles, "rendering");
-    let counts = vec![a.spp; (w * h) as usize];
-    let ((img, _), t_render) = timed(|| render_adaptive(&world, &counts, a.seed, Some(&|| b.inc(1))));
+    let mut renderer = Renderer::new(&world, settings).map_err(|e| e.to_string())?;
+    let (b, start) = match a.time {
+        None => (bar(renderer.progress_len(), "rendering"), None),
+        Some(t) => (seconds_bar(t), Some(std::time::Instant::now())),
+    };
+    let tick = || match start {
+        None => b.inc(1),
+        Some(s) => b.set_position(s.elapsed().as_millis() as u64),
+    };
+    let r = renderer.render(Some(&tick)).map_err(|e| e.to_string());
     b.finish_and_clear();
-    write_image(&img, &a.output, &png)?;
-    out.push_str(&format!(
-        "render: {} spp in {t_render:.2} s ({:.3e} camera samples/s)\n  {}\n  {}\n",
-        a.spp,
-        (w as f64 * h as f64 * a.spp as f64) / t_render.max(1e-9),
-        a.output.display(),
-        png.display()
-    ));
-    if a.cov_paths > 0 {
-        let b = bar(tiles, "covariance");
-        let (maps, t_cov) = timed(|| covariance_maps_with(&world, a.cov_paths, a.seed, Some(&|| b.inc(1))));
-        b.finish_and_clear();
-        let maps = maps?;
+    let r = r?;
+    write_image(&r.image, &a.output, &png).map_err(|e| e.to_string())?;
+    let total = r.timing.total();
+    if let Some(maps) = renderer.maps() {
         let sp = covtrace::sensor::SensorParams::default();
-        write_maps(&maps, sp.filter, sp.max_filter, &density, &filter, &json)?;
+        write_maps(maps, sp.filter, sp.max_filter, &density, &filter, &json).map_err(|e| e.to_string())?;
         let mean_spp = maps.pixels.iter().map(|p| p.spp).sum::<f64>() / maps.pixels.len().max(1) as f64;
         out.push_str(&format!(
-            "covariance: {} paths per pixel in {t_cov:.2} s ({:.1}% of the total); predicted {mean_spp:.2} spp on average\n  {}\n  {}\n  {}\n",
-            a.cov_paths,
-            100.0 * t_cov / (t_cov + t_render).max(1e-9),
-            density.display(),
-            filter.display(),
-            json.display()
+            "covariance: {} path(s) per {s}×{s} block, layout {} ({}), in {:.2} s ({:.1}% of the render); predicted {mean_spp:.1} spp on average\n",
+            maps.paths_per_block,
+            maps.layout,
+            layout_axes(maps.layout),
+            r.timing.covariance,
+            100.0 * r.timing.covariance / total.max(1e-9),
+            s = maps.stride,
         ));
     }
+    let n = f64::from(w) * f64::from(h);
+    let reached = match a.time {
+        None => String::new(),
+        Some(t) => format!(
+            "; {} pass(es) of {} spp in the {t} s asked, {:.1} spp on average reached",
+            r.passes,
+            a.spp,
+            r.samples as f64 / n
+        ),
+    };
+    out.push_str(&format!(
+        "render: {}, {} samples ({:.1} spp on average) in {total:.2} s (sampling {:.2} s, reconstruction {:.2} s){reached}\n",
+        r.method.name(),
+        r.samples,
+        r.samples as f64 / n,
+        r.timing.sampling,
+        r.timing.reconstruction,
+    ));
+    let mut written = vec![a.output.clone(), png];
+    if renderer.maps().is_some() {
+        written.extend([density, filter, json]);
+    }
+    out.push_str("wrote:\n");
+    for f in written {
+        out.push_str(&format!("  {}\n", cov_render::echo(&f.display().to_string())));
+    }
     Ok(out)
+}
+
+/// The axes of a covariance layout.
+fn layout_axes(n: usize) -> &'static str {
+    match n {
+        2 => "x, u",
+        3 => "x, u, t",
+        4 => "x, y, u, v",
+        _ => "x, y, u, v, t",
+    }
+}
+
+/// A progress bar over the seconds of a time-limited render.
+fn seconds_bar(secs: f64) -> ProgressBar {
+    let b = ProgressBar::new((secs * 1000.0) as u64);
+    b.set_style(
+        ProgressStyle::with_template("{msg:12} {bar:40} {elapsed} of the time asked")
+            .unwrap_or_else(|_| ProgressStyle::default_bar()),
+    );
+    b.set_message("rendering");
+    b
 }
 
 /// What `covtrace render-check` was asked (parsed by clap).
@@ -211,22 +321,27 @@ pub fn check(a: &CheckArgs) -> Result<String, String> {
     if let Some(j) = &a.json {
         check_output(j, "json")?;
     }
-    let mut world = World::load(&a.scene).map_err(|e| e.to_string())?;
-    if let Some((w, h)) = a.size {
-        world = world.with_resolution(w, h);
-    }
+    let world = load(&a.scene, a.size)?;
     let (w, h) = (world.camera.width, world.camera.height);
     let tiles = tile_count(&world);
+    let uniform = |spp: u32, seed: u64, max_luminance: f64| RenderSettings {
+        method: Method::Uniform,
+        spp: f64::from(spp),
+        seed,
+        max_luminance,
+        ..RenderSettings::default()
+    };
+    let render = |s: RenderSettings, b: &ProgressBar| -> Result<cov_render::Image, String> {
+        let mut r = Renderer::new(&world, s).map_err(|e| e.to_string())?;
+        Ok(r.render(Some(&|| b.inc(1))).map_err(|e| e.to_string())?.image)
+    };
     // Two independent references (other seeds): their cross-spectrum has no noise term.
     // Samples are clamped at 4× the image's mean luminance (from a 4-spp preview), so
     // that rare caustic fireflies, which no pair of renders cancels, do not read as detail.
-    let preview = render_adaptive(
-        &world,
-        &vec![4; (w * h) as usize],
-        a.seed.wrapping_add(3000),
-        None,
-    )
-    .0;
+    let preview = render(
+        uniform(4, a.seed.wrapping_add(3000), f64::INFINITY),
+        &ProgressBar::hidden(),
+    )?;
     let mean_l = preview
         .pixels
         .iter()
@@ -235,23 +350,25 @@ pub fn check(a: &CheckArgs) -> Result<String, String> {
         / (w * h) as f64;
     let clamp = if mean_l > 0.0 { 4.0 * mean_l } else { f64::INFINITY };
     let b = bar(2 * tiles, "reference");
-    let counts = vec![a.ref_spp; (w * h) as usize];
-    let reference = |k: u64| {
-        render_clamped(
-            &world,
-            &counts,
-            a.seed.wrapping_add(k * 1000),
-            clamp,
-            Some(&|| b.inc(1)),
-        )
-        .0
-    };
-    let ((ref_a, ref_b), t_ref) = timed(|| (reference(1), reference(2)));
+    let reference = |k: u64| render(uniform(a.ref_spp, a.seed.wrapping_add(k * 1000), clamp), &b);
+    let (refs, t_ref) = timed(|| (reference(1), reference(2)));
     b.finish_and_clear();
+    let (ref_a, ref_b) = (refs.0?, refs.1?);
+    // The maps at one prediction per pixel (the finest grid), `cov_paths` paths each.
     let b = bar(tiles, "covariance");
-    let (maps, t_cov) = timed(|| covariance_maps_with(&world, a.cov_paths, a.seed, Some(&|| b.inc(1))));
+    let mut renderer = Renderer::new(
+        &world,
+        RenderSettings {
+            cov_paths: a.cov_paths,
+            cov_stride: 1,
+            seed: a.seed,
+            ..RenderSettings::default()
+        },
+    )
+    .map_err(|e| e.to_string())?;
+    let (maps, t_cov) = timed(|| renderer.trace_covariance(Some(&|| b.inc(1))).cloned());
     b.finish_and_clear();
-    let maps = maps?;
+    let maps = maps.map_err(|e| e.to_string())?;
     let filter = covtrace::sensor::SensorParams::default().filter;
     let agreement = cov_render::validate::compare(&ref_a, &ref_b, &maps, filter);
     if let Some(j) = &a.json {
@@ -260,12 +377,12 @@ pub fn check(a: &CheckArgs) -> Result<String, String> {
     }
     let n = agreement.tiles.len();
     Ok(format!(
-        "scene: {} ({w}×{h} px), two references of {} spp in {t_ref:.1} s, covariance {} paths/px in {t_cov:.2} s\n\
+        "scene: {} ({w}×{h} px), two references of {} spp in {t_ref:.1} s, covariance {} path(s) per pixel in {t_cov:.2} s\n\
          tiles of {t}×{t} px: {n}, with detail: {}\n\
          predicted / measured bandwidth (median over tiles with detail): {}\n\
          rank correlation (Spearman) over tiles with detail: {}\n\
          under-sampled tiles (predicted < half the measured bandwidth): {:.1}% of tiles with detail",
-        a.scene.display(),
+        cov_render::echo(&a.scene.display().to_string()),
         a.ref_spp,
         a.cov_paths,
         agreement.detail_tiles,

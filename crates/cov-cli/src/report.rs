@@ -17,7 +17,7 @@ use plotters::prelude::*;
 
 use crate::plot::{COLORS, log_tick};
 
-/// One bundled chain: its operators and its primal field built from PHYSICS.md.
+/// One bundled chain: its operators and its primal field built from docs/physics.md.
 pub struct Case {
     /// Name in the table.
     pub name: &'static str,

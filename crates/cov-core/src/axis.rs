@@ -1,4 +1,4 @@
-//! Axes and layouts (PHYSICS.md section 1).
+//! Axes and layouts (docs/physics.md section 1).
 //!
 //! The axis order is always `x, y, u, v, t`; a layout of size `N` keeps a subset of them:
 //!

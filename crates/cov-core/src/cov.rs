@@ -10,7 +10,7 @@ use crate::axis::{Axis, axis_index, layout_axes};
 use crate::linalg::{MAX, Small, sym_eigen};
 
 /// `4π²`: the factor between a Gaussian's primal covariance and its spectrum covariance
-/// (`Σ = C⁻¹ / 4π²`, PHYSICS.md section 1).
+/// (`Σ = C⁻¹ / 4π²`, docs/physics.md section 1).
 pub const FOUR_PI_SQ: f64 = 4.0 * PI * PI;
 
 /// Relative tolerance of the positive semi-definiteness checks (dimensionless): a
@@ -28,7 +28,7 @@ const PACKED: usize = MAX * (MAX + 1) / 2;
 /// The covariance Σ of the local amplitude spectrum of radiance around a ray, for the
 /// layout of size `N` (2: x,u; 3: x,u,t; 4: x,y,u,v; 5: x,y,u,v,t).
 ///
-/// Entries are in (cycles per unit)² of the axes involved (PHYSICS.md section 1).
+/// Entries are in (cycles per unit)² of the axes involved (docs/physics.md section 1).
 /// Storage is the packed upper triangle, so Σ is symmetric by construction: every setter
 /// writes `Σ_ij` and `Σ_ji` at once. Only `N ∈ {2, 3, 4, 5}` compiles.
 #[derive(Clone, Copy, PartialEq)]
@@ -37,7 +37,7 @@ pub struct Cov<const N: usize> {
 }
 
 impl<const N: usize> Cov<N> {
-    /// Compile-time guard: only the four layouts of PHYSICS.md exist.
+    /// Compile-time guard: only the four layouts of docs/physics.md exist.
     const LAYOUT_OK: () = assert!(N >= 2 && N <= 5, "covtrace layouts have N = 2, 3, 4 or 5");
 
     /// Number of packed entries, `N(N+1)/2`.

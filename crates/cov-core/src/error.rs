@@ -118,15 +118,24 @@ pub fn num(v: f64) -> String {
 /// Longest piece of user input echoed in a message (characters).
 pub const ECHO_MAX: usize = 64;
 
-/// User input as messages echo it: cut to [`ECHO_MAX`] characters with `…` and its length
-/// when longer, so that a 50 MB name never becomes a 50 MB error line.
+/// User input as messages echo it: control characters (a line break, a tab, an escape)
+/// written as escapes (`\n`, `\t`, `\u{1b}`), so that a message stays one line, and cut
+/// to [`ECHO_MAX`] characters with `…` and its length when longer, so that a 50 MB name
+/// never becomes a 50 MB error line.
 pub fn echo(s: &str) -> String {
-    if s.chars().count() <= ECHO_MAX {
-        s.to_string()
-    } else {
-        let cut: String = s.chars().take(ECHO_MAX).collect();
-        format!("{cut}… ({} characters)", s.chars().count())
+    let n = s.chars().count();
+    let mut out = String::new();
+    for c in s.chars().take(ECHO_MAX) {
+        if c.is_control() {
+            out.extend(c.escape_default());
+        } else {
+            out.push(c);
+        }
     }
+    if n > ECHO_MAX {
+        out.push_str(&format!("… ({n} characters)"));
+    }
+    out
 }
 
 /// Line and column (1-based, columns in characters) of the end of `before`: the position

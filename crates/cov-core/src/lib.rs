@@ -1,7 +1,7 @@
 //! # cov-core
 //!
 //! The shared machinery of covtrace: the spectrum covariance [`Cov<N>`] of the local light
-//! field around a ray, generic over the four layouts of `../shared/PHYSICS.md`
+//! field around a ray, generic over the four layouts of `docs/physics.md`
 //! (`N = 2`: x,u; `3`: x,u,t; `4`: x,y,u,v; `5`: x,y,u,v,t), the [`Operator`] trait that
 //! every event on a light path implements, [`Chain`]s of operators, the kernels that
 //! implement the four algebraic rules, and the queries a renderer needs.

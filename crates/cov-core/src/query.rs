@@ -1,4 +1,4 @@
-//! Queries: what a renderer reads off Σ (PHYSICS.md section 4).
+//! Queries: what a renderer reads off Σ (docs/physics.md section 4).
 
 use crate::Spectrum;
 use std::f64::consts::PI;

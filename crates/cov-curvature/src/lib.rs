@@ -1,6 +1,6 @@
 //! # cov-curvature: curved surfaces
 //!
-//! **Primal definition** (PHYSICS.md section 3), in the surface frame after projection:
+//! **Primal definition** (docs/physics.md section 3), in the surface frame after projection:
 //! `l'(x,u) = l(x, u + k·x)`. In 3D a surface has a curvature tensor `K` (symmetric
 //! 2×2, 1/m) and `(u,v) ← (u,v) + K (x,y)`; with principal curvatures `kx ≠ ky` along a
 //! principal direction at angle `α` from the frame's `x`, `K = R(α) diag(kx, ky) R(α)ᵀ`.

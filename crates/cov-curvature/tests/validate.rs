@@ -14,7 +14,7 @@ fn isotropic_curvature_2d_matches_ground_truth() {
         let stds = [0.1, 0.3];
         let mut p = Cov::<2>::gaussian(stds).unwrap();
         Operator::apply(&Curvature::isotropic(k).unwrap(), &mut p).unwrap();
-        // PHYSICS: l'(x,u) = l(x, u + k·x).
+        // docs/physics.md: l'(x,u) = l(x, u + k·x).
         let f = Field::gaussian(&stds).then(Primal::shear(2, 1, 0, k));
         let r = compare(&f, &p, &Grid::auto(&p, 64, &[1.0; 2])).unwrap();
         assert!(r.rel_error < 1e-3, "k={k}: {:e}", r.rel_error);

@@ -1,6 +1,6 @@
 //! # cov-defocus: thin lens, aperture, pinhole
 //!
-//! **Primal definitions** (PHYSICS.md section 3): a thin lens of focal length `f` is a
+//! **Primal definitions** (docs/physics.md section 3): a thin lens of focal length `f` is a
 //! curvature of `1/f`, `l'(x,u) = l(x, u + x/f)`, followed by travel to the sensor; the
 //! aperture is a window on the lens position (rule 2); the sensor integrates over the
 //! lens (rule 4, done by cov-sensor). The sensor sits where the focus plane is imaged:

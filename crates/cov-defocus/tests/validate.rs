@@ -12,7 +12,7 @@ fn lens_case(s: f64, d_o: f64, lens: &ThinLens) -> (Cov<3>, Field) {
     let mut p = Cov::<3>::gaussian(stds).unwrap();
     p.shear(Axis::X, Axis::U, -d_o).unwrap();
     Operator::apply(lens, &mut p).unwrap();
-    // PHYSICS: aperture window on x, lens l(x, u + x/f), travel d_s.
+    // docs/physics.md: aperture window on x, lens l(x, u + x/f), travel d_s.
     let (f, a, d_s) = (0.05, lens.aperture(), lens.sensor_distance());
     let field = Field::gaussian(&stds)
         .then(Primal::travel(3, d_o))

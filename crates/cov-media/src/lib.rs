@@ -1,6 +1,6 @@
 //! # cov-media: participating media
 //!
-//! **Absorption** (PHYSICS.md section 3: transmittance is a primal product, rule 2). Across
+//! **Absorption** (docs/physics.md section 3: transmittance is a primal product, rule 2). Across
 //! the ray, the extinction coefficient is expanded to second order,
 //! `σ_t(p) ≈ σ₀ + gᵀp + ½ pᵀ H p` (`p` the transverse position, `σ_t` in 1/m, `g` in 1/m²,
 //! `H` in 1/m³). A ray with coordinates `(x, u)` at the start of a segment of length `L`

@@ -10,7 +10,7 @@ use cov_validate::{Field, Grid, Primal, compare};
 
 const STDS: [f64; 2] = [0.1, 0.2];
 
-/// Transmittance by quadrature of σ_t along the ray (PHYSICS: a primal product).
+/// Transmittance by quadrature of σ_t along the ray (docs/physics.md: a primal product).
 fn transmittance(length: f64, sigma: impl Fn(f64) -> f64 + Send + Sync + 'static) -> Primal {
     Primal::Window(Arc::new(move |z: &[f64]| {
         let n = 200;

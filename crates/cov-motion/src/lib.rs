@@ -1,6 +1,6 @@
 //! # cov-motion: moving objects, moving cameras, shutters
 //!
-//! **Primal definition** (PHYSICS.md section 3): an object moving with velocity `v` (m/s,
+//! **Primal definition** (docs/physics.md section 3): an object moving with velocity `v` (m/s,
 //! in the tangent plane) acts through its static operator applied in its own frame,
 //! `x_o = x − v·t`; e.g. a moving window gives `l'(x,u,t) = l(x,u,t)·w(x − v·t)`. An
 //! object turning at angular velocity `ω` (rad/s) sees directions `u_o = u − ω·t`.

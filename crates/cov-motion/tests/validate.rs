@@ -24,7 +24,7 @@ fn moving_windows_match_ground_truth_at_several_speeds() {
         let s = 0.05;
         let mut p = Cov::<3>::gaussian(STDS).unwrap();
         Operator::apply(&moving_window(v, s), &mut p).unwrap();
-        // PHYSICS: l'(x,u,t) = l(x,u,t)·w(x − v·t).
+        // docs/physics.md: l'(x,u,t) = l(x,u,t)·w(x − v·t).
         let f = Field::gaussian(&STDS).then(Primal::Window(Arc::new(move |z: &[f64]| {
             let xo = z[0] - v * z[2];
             (-0.5 * xo * xo / (s * s)).exp()

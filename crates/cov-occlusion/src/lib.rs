@@ -1,6 +1,6 @@
 //! # cov-occlusion: occluders, blockers and textures as windows
 //!
-//! **Primal definition** (PHYSICS.md section 3): an occluder, a texture or any window `w`
+//! **Primal definition** (docs/physics.md section 3): an occluder, a texture or any window `w`
 //! multiplies the light field, `l'(z) = l(z)·w(z)`. By rule 2 the spectra convolve and
 //! `Σ' = Σ + W`, `W` the spectrum covariance of `w`. Planar occluders act on the spatial
 //! axes only; a thick occluder is sliced along its depth, with travel between slices.

@@ -1,6 +1,6 @@
 //! # cov-projection: from the ray to the surface and back
 //!
-//! **Primal definitions** (PHYSICS.md section 3), with `c = |cos θ|` and the frame's `x`
+//! **Primal definitions** (docs/physics.md section 3), with `c = |cos θ|` and the frame's `x`
 //! axis in the plane of incidence:
 //!
 //! - projection, ray → surface: `l'(x,u) = l(c·x, u)` ([`Project`]);

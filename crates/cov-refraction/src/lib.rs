@@ -1,6 +1,6 @@
 //! # cov-refraction: Snell interfaces, smooth and rough
 //!
-//! **Primal definition** (PHYSICS.md section 3), frame `x` in the plane of incidence:
+//! **Primal definition** (docs/physics.md section 3), frame `x` in the plane of incidence:
 //! spatially, a projection with `cos_i` then an inverse projection with `cos_t`, i.e.
 //! `l'(x,u) = l(x·cos_i/cos_t, u)`; in angle, `u_t = a·u_i` with
 //! `a = n1 cos_i / (n2 cos_t)`, i.e. `l'(x,u) = l(x, u/a)`.

@@ -5,8 +5,7 @@
 use std::hint::black_box;
 use std::path::Path;
 
-use cov_render::World;
-use cov_render::render::{covariance_maps, render};
+use cov_render::{World, covariance_maps, render};
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 
 const W: u32 = 64;
@@ -30,7 +29,7 @@ fn scenes(c: &mut Criterion) {
         });
         g.bench_function(
             "covariance pass, 1 path per pixel, 1 thread (elements = paths)",
-            |b| b.iter(|| pool.install(|| black_box(covariance_maps(&world, 1, 1).expect("maps")))),
+            |b| b.iter(|| pool.install(|| black_box(covariance_maps(&world, 1, 1, 1, None).expect("maps")))),
         );
         g.finish();
     }

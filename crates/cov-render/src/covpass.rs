@@ -375,3 +375,173 @@ fn nearest_silhouette(world: &World, hit: &Hit, px: f64, py: f64, time: f64, ut:
     }
     best
 }
+
+/// Largest number of covariance paths per block of the covariance grid.
+pub const MAX_COV_PATHS: u32 = 256;
+/// Sides of the covariance grid's blocks [`covariance_maps`] accepts (px; they divide a
+/// tile).
+pub const STRIDES: [u32; 5] = [1, 2, 4, 8, 16];
+
+/// The covariance maps of an image: per pixel, the predicted image-space Σ and samples
+/// per pixel.
+#[derive(Clone, Debug, PartialEq)]
+pub struct CovMaps {
+    /// Width (px).
+    pub width: u32,
+    /// Height (px).
+    pub height: u32,
+    /// Per pixel.
+    pub pixels: Vec<PixelCov>,
+    /// Covariance paths traced per block of the grid.
+    pub paths_per_block: u32,
+    /// Side of the grid's blocks (px; 1: a prediction per pixel).
+    pub stride: u32,
+    /// Layout the paths were traced in.
+    pub layout: usize,
+}
+
+/// The image of per-tile results, each tile's values row by row, in tile order.
+fn assemble<T: Clone>(
+    w: u32,
+    h: u32,
+    tiles: &[(u32, u32, u32, u32)],
+    results: Vec<Vec<T>>,
+    fill: T,
+) -> Vec<T> {
+    let mut out = vec![fill; w as usize * h as usize];
+    for (&(x0, y0, x1, y1), tile) in tiles.iter().zip(results) {
+        let coords = (y0..y1).flat_map(|y| (x0..x1).map(move |x| (y * w + x) as usize));
+        for (i, v) in coords.zip(tile) {
+            out[i] = v;
+        }
+    }
+    out
+}
+
+/// The generator of the covariance pass's tile `index`: seeded by the scene seed, one
+/// stream per tile, so maps do not depend on the thread count.
+fn tile_rng(seed: u64, index: usize) -> rand_chacha::ChaCha8Rng {
+    use rand::SeedableRng;
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed ^ (1 << 56));
+    rng.set_stream(index as u64);
+    rng
+}
+
+/// Traces `paths` covariance paths (1 to [`MAX_COV_PATHS`]) per block of `stride × stride`
+/// pixels, jittered over the block and the shutter; every pixel of a block gets the
+/// block's radiance-weighted prediction. A coarser grid costs `stride²` times less; a block
+/// that holds an edge predicts for all its pixels the detail that its paths saw, so edges
+/// widen to the block, which narrows filters and raises densities near them
+/// (conservative).
+///
+/// # Errors
+/// `paths` or `stride` out of range ([`STRIDES`]); an operator that rejects what the scene
+/// gives it, with the pixel it happened at.
+pub fn covariance_maps(
+    world: &World,
+    paths: u32,
+    stride: u32,
+    seed: u64,
+    progress: crate::film::Progress<'_>,
+) -> Result<CovMaps, crate::RenderError> {
+    use rayon::prelude::*;
+    if !STRIDES.contains(&stride) {
+        return Err(crate::RenderError::setting(
+            "the covariance grid's stride",
+            format!("one of {STRIDES:?}"),
+            stride,
+        ));
+    }
+    if !(1..=MAX_COV_PATHS).contains(&paths) {
+        return Err(crate::RenderError::setting(
+            "covariance paths per block",
+            format!("1 to {MAX_COV_PATHS}"),
+            paths,
+        ));
+    }
+    let cc = CovCamera::new(world).map_err(|e| crate::RenderError::Camera(e.to_string()))?;
+    let (w, h) = (world.camera.width, world.camera.height);
+    let tl = crate::film::tiles(w, h);
+    let results: Result<Vec<Vec<PixelCov>>, crate::RenderError> = tl
+        .par_iter()
+        .enumerate()
+        .map(|(index, &(x0, y0, x1, y1))| {
+            let mut rng = tile_rng(seed, index);
+            let mut out = vec![PixelCov::default(); ((x1 - x0) * (y1 - y0)) as usize];
+            for by in (y0..y1).step_by(stride as usize) {
+                for bx in (x0..x1).step_by(stride as usize) {
+                    let (sx, sy) = ((x1 - bx).min(stride), (y1 - by).min(stride));
+                    let acc = block_cov(world, &cc, (bx, by), (sx, sy), paths, &mut rng)?;
+                    for y in by..by + sy {
+                        for x in bx..bx + sx {
+                            out[((y - y0) * (x1 - x0) + (x - x0)) as usize] = acc;
+                        }
+                    }
+                }
+            }
+            if let Some(p) = progress {
+                p();
+            }
+            Ok(out)
+        })
+        .collect();
+    Ok(CovMaps {
+        width: w,
+        height: h,
+        pixels: assemble(w, h, &tl, results?, PixelCov::default()),
+        paths_per_block: paths,
+        stride,
+        layout: cc.layout(),
+    })
+}
+
+/// The radiance-weighted mean prediction of `paths` paths through the block of `size`
+/// pixels at `at`.
+fn block_cov<R: Rng>(
+    world: &World,
+    cc: &CovCamera,
+    (x, y): (u32, u32),
+    (sx, sy): (u32, u32),
+    paths: u32,
+    rng: &mut R,
+) -> Result<PixelCov, crate::RenderError> {
+    let mut acc = PixelCov::default();
+    let (mut plain, mut n_plain, mut plain_spp) = ([0.0; 3], 0.0, 0.0);
+    for _ in 0..paths {
+        let (jx, jy, ut) = (
+            rng.random::<f64>() * f64::from(sx),
+            rng.random::<f64>() * f64::from(sy),
+            rng.random::<f64>(),
+        );
+        let (px, py) = (f64::from(x) + jx, f64::from(y) + jy);
+        let r = trace_path(world, cc, px, py, ut, rng).map_err(|e| crate::RenderError::Covariance {
+            x: px.floor() as u32,
+            y: py.floor() as u32,
+            message: e.to_string(),
+        })?;
+        let Some((d, wgt)) = r else { continue };
+        let s = [d.image_cov_px[0][0], d.image_cov_px[0][1], d.image_cov_px[1][1]];
+        if !(s.iter().all(|v| v.is_finite()) && d.samples_per_pixel.is_finite()) {
+            continue;
+        }
+        for k in 0..3 {
+            acc.sigma[k] += wgt * s[k];
+            plain[k] += s[k];
+        }
+        acc.spp += wgt * d.samples_per_pixel;
+        acc.weight += wgt;
+        plain_spp += d.samples_per_pixel;
+        n_plain += 1.0;
+    }
+    if acc.weight > 0.0 {
+        for k in 0..3 {
+            acc.sigma[k] /= acc.weight;
+        }
+        acc.spp /= acc.weight;
+    } else if n_plain > 0.0 {
+        // No path carried light: the geometry's content, unweighted.
+        acc.sigma = plain.map(|v| v / n_plain);
+        acc.spp = plain_spp / n_plain;
+    }
+    Ok(acc)
+}

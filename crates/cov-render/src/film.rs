@@ -24,10 +24,60 @@
 use glam::DVec3;
 use rayon::prelude::*;
 
-use crate::render::{Image, Progress, tiles};
 use crate::sampler::{MAX_INDEX, Sampler, SobolSampler};
 use crate::trace::{luminance, radiance_parts};
 use crate::world::World;
+
+/// Tile side (px): the unit of work of rendering and of the covariance pass.
+pub const TILE: u32 = 16;
+/// Largest number of samples one pixel takes.
+pub const MAX_SPP: u32 = 1 << 16;
+
+/// A linear RGB image.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Image {
+    /// Width (px).
+    pub width: u32,
+    /// Height (px).
+    pub height: u32,
+    /// Pixels, row by row from the top.
+    pub pixels: Vec<DVec3>,
+}
+
+impl Image {
+    /// A black image.
+    pub fn new(width: u32, height: u32) -> Image {
+        Image {
+            width,
+            height,
+            pixels: vec![DVec3::ZERO; width as usize * height as usize],
+        }
+    }
+
+    /// Pixel `(x, y)`.
+    pub fn get(&self, x: u32, y: u32) -> DVec3 {
+        self.pixels[y as usize * self.width as usize + x as usize]
+    }
+}
+
+/// The tiles of a `width × height` image: (x0, y0, x1, y1), row by row.
+pub fn tiles(width: u32, height: u32) -> Vec<(u32, u32, u32, u32)> {
+    let mut out = Vec::new();
+    for y0 in (0..height).step_by(TILE as usize) {
+        for x0 in (0..width).step_by(TILE as usize) {
+            out.push((x0, y0, (x0 + TILE).min(width), (y0 + TILE).min(height)));
+        }
+    }
+    out
+}
+
+/// Number of tiles of the world's image (what [`Progress`] counts to, once per pass).
+pub fn tile_count(world: &World) -> usize {
+    tiles(world.camera.width, world.camera.height).len()
+}
+
+/// Called once per finished tile (to drive a progress bar).
+pub type Progress<'a> = Option<&'a (dyn Fn() + Sync)>;
 
 /// Largest filter std the film accepts (px); larger ones are clamped. Bounds the margin
 /// a band splats into (3 std).
@@ -317,7 +367,7 @@ impl Film {
     }
 
     /// Takes `counts[i]` more samples in pixel `i`, continuing each pixel's sequence (a
-    /// pixel never takes more than [`crate::MAX_SPP`] in all). Each sample's luminance is
+    /// pixel never takes more than [`MAX_SPP`] in all). Each sample's luminance is
     /// clamped to `max_luminance` (colour scaled down; `∞` for an unbiased image).
     pub fn render(
         &mut self,

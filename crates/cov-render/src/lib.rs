@@ -1,52 +1,65 @@
 //! # cov-render: a renderer driven by covariance tracing
 //!
 //! A CPU path tracer (area lights with soft shadows, one indirect bounce, defocus over a
-//! thin lens, motion blur over the shutter) whose scenes are RON files ([`scene`]), and a
-//! **covariance pass** ([`covpass`]) that builds, for each pixel, the operator chains of
-//! the covtrace library along a few camera paths and reduces them to the sensor's
-//! decisions: how many samples the pixel needs over pixel × lens × time, and how wide its
-//! reconstruction filter may be. The renderer never re-derives an operator's formula: it
-//! only chooses the operators and their parameters from what the rays hit.
+//! thin lens, motion blur over the shutter) whose scenes are RON files, and a
+//! **covariance pass** that builds, for each pixel, the operator chains of the covtrace
+//! library along a few camera paths and reduces them to the sensor's decisions: how many
+//! samples the pixel needs over pixel × lens × time, and how wide its reconstruction
+//! filter may be. The renderer never re-derives an operator's formula: it only chooses the
+//! operators and their parameters from what the rays hit.
 //!
 //! ```no_run
-//! use cov_render::{World, covariance_maps, render};
+//! use cov_render::{RenderSettings, Renderer, World};
 //!
 //! let world = World::load(std::path::Path::new("examples/scenes/cornell.ron"))?;
-//! let image = render(&world, 16, 1); // 16 samples per pixel, seed 1
-//! let maps = covariance_maps(&world, 4, 1)?; // 4 covariance paths per pixel
-//! println!("{} px, predicted {:.1} spp at the centre", image.pixels.len(),
-//!     maps.pixels[maps.pixels.len() / 2].spp);
+//! // Covariance tracing (the default method) at 16 samples per pixel on average.
+//! let mut renderer = Renderer::new(&world, RenderSettings::default())?;
+//! let out = renderer.render(None)?;
+//! println!("{} px, {} samples, covariance pass {:.2} s of {:.2} s", out.image.pixels.len(),
+//!     out.samples, out.timing.covariance, out.timing.total());
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
 //!
-//! Rendering with the covariance pass ([`mod@bench`]): samples are allocated to pixels in
-//! proportion to the predicted density, and each pixel's samples are reconstructed by a
-//! Gaussian filter made from its image-space Σ ([`film`]), scaled per pixel to balance the
-//! bias the spectrum predicts against the noise of the samples it averages. The baselines a
-//! user would pick without covariance tracing (uniform sampling with a box or a fixed
-//! Gaussian filter, two-pass variance-driven sampling) run through the same film, and
-//! `covtrace render-bench` measures image error against wall-clock time for all of them.
+//! The modules, in the order data flows through them (each uses only those above it):
 //!
-//! Determinism: pixels draw from their own Owen-scrambled Sobol sequences ([`sampler`])
-//! and the covariance pass's tiles from generators seeded by the scene seed and the tile
-//! index; results are added in a fixed order, so an image is the same on any number of
-//! threads.
+//! | module | job |
+//! |---|---|
+//! | [`scene`] | the scene description a user writes (RON), checked where it is written |
+//! | [`world`] | the scene as the renderer uses it: camera, lights, materials, geometry |
+//! | [`geometry`], [`material`] | shapes under a BVH; BRDFs and their covariance lobes |
+//! | [`trace`] | the path tracer's radiance estimate of one camera ray |
+//! | [`sampler`] | each pixel's Owen-scrambled Sobol sequence |
+//! | [`film`] | where samples land (tiles, per-pixel sums) and how they become pixels |
+//! | [`covpass`] | the covariance pass: operator chains per path, the per-pixel maps |
+//! | [`adaptive`] | sample allocation and per-pixel filters from the maps |
+//! | [`renderer`] | one renderer for every method: [`Renderer`], [`RenderSettings`] |
+//! | [`metrics`], [`bench`] | image error against a reference; error against time |
+//! | [`output`], [`validate`] | files written; the maps checked against reference images |
+//!
+//! Errors are [`RenderError`]s (scene errors are positioned [`SceneError`]s), one line each.
 
 #![warn(missing_docs)]
 
+pub mod adaptive;
 pub mod bench;
 pub mod covpass;
+mod error;
 pub mod film;
 pub mod geometry;
 pub mod material;
-pub mod render;
+pub mod metrics;
+pub mod output;
+pub mod renderer;
 pub mod sampler;
 pub mod scene;
 pub mod trace;
 pub mod validate;
 pub mod world;
 
-pub use render::{CovMaps, Image, MAX_COV_PATHS, MAX_SPP, covariance_maps, render, render_adaptive};
+pub use covpass::{CovMaps, MAX_COV_PATHS, covariance_maps};
+pub use error::RenderError;
+pub use film::{Image, MAX_SPP};
+pub use renderer::{Method, RenderSettings, Rendered, Renderer, render};
 pub use scene::SceneError;
 pub use world::World;
 

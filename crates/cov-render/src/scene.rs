@@ -151,9 +151,9 @@ pub struct SceneFile {
     pub camera: CameraDesc,
     /// Named materials.
     #[serde(default)]
-    pub materials: BTreeMap<String, MaterialDesc>,
+    pub materials: BTreeMap<At<String>, MaterialDesc>,
     /// Emitters.
-    pub lights: Vec<LightDesc>,
+    pub lights: At<Vec<LightDesc>>,
     /// Geometry.
     pub shapes: Vec<ShapeDesc>,
 }
@@ -165,12 +165,12 @@ pub struct CameraDesc {
     /// Centre of the lens (m).
     pub position: V3,
     /// Point aimed at (m).
-    pub look_at: V3,
+    pub look_at: At<V3>,
     /// Up vector (default +y).
     #[serde(default)]
-    pub up: Option<V3>,
+    pub up: Option<At<V3>>,
     /// Horizontal field of view (degrees).
-    pub fov: Positive,
+    pub fov: At<Positive>,
     /// Image width (px).
     pub width: Resolution,
     /// Image height (px).
@@ -193,7 +193,7 @@ pub struct LensDesc {
     /// Lens radius (m); 0 is a pinhole.
     pub aperture: NonNegative,
     /// Distance in focus (m).
-    pub focus_distance: Positive,
+    pub focus_distance: At<Positive>,
     /// Focal length (m), default 0.05.
     #[serde(default)]
     pub focal_length: Option<Positive>,
@@ -206,7 +206,7 @@ pub struct ShutterDesc {
     /// Opening time.
     pub open: Finite,
     /// Closing time (> open).
-    pub close: Finite,
+    pub close: At<Finite>,
 }
 
 /// A material.
@@ -243,7 +243,7 @@ pub enum LightDesc {
         /// A corner (m).
         corner: V3,
         /// First edge (m).
-        edge_u: V3,
+        edge_u: At<V3>,
         /// Second edge (m).
         edge_v: V3,
         /// Radiance.
@@ -271,7 +271,7 @@ pub enum ShapeDesc {
         /// Radius (m).
         radius: Positive,
         /// Material name.
-        material: String,
+        material: At<String>,
         /// Velocity (m/s).
         #[serde(default)]
         velocity: Option<V3>,
@@ -281,11 +281,11 @@ pub enum ShapeDesc {
         /// A corner (m).
         corner: V3,
         /// First edge (m).
-        edge_u: V3,
+        edge_u: At<V3>,
         /// Second edge (m).
         edge_v: V3,
         /// Material name.
-        material: String,
+        material: At<String>,
         /// Velocity (m/s).
         #[serde(default)]
         velocity: Option<V3>,
@@ -293,9 +293,9 @@ pub enum ShapeDesc {
     /// A triangle mesh from an OBJ file (path relative to the scene file).
     Mesh {
         /// The OBJ file.
-        obj: String,
+        obj: At<String>,
         /// Material name.
-        material: String,
+        material: At<String>,
         /// Translation (m), applied after scaling.
         #[serde(default)]
         translate: Option<V3>,
@@ -308,9 +308,62 @@ pub enum ShapeDesc {
     },
 }
 
-/// Line and column (1-based) of the first occurrence of `needle` in `text`.
-pub(crate) fn position_of(text: &str, needle: &str) -> Option<(usize, usize)> {
-    Some(cov_core::line_col(&text[..text.find(needle)?]))
+/// A value whose place in the file the parser can give back: every `At` is numbered in
+/// the order the parser reads it, and [`SceneFile::locate`] parses the text again, stopping
+/// at that number, so that ron reports its own line and column there. Checks made after
+/// parsing (a material that does not exist, a lens that cannot focus) are positioned this
+/// way, from the parser's spans, never by searching the text.
+#[derive(Clone, Debug)]
+pub struct At<T> {
+    /// The value.
+    pub value: T,
+    /// Its number in reading order.
+    pub ordinal: u32,
+}
+
+impl<T: PartialEq> PartialEq for At<T> {
+    fn eq(&self, other: &Self) -> bool {
+        self.value == other.value
+    }
+}
+
+impl<T: Eq> Eq for At<T> {}
+
+impl<T: Ord> PartialOrd for At<T> {
+    fn partial_cmp(&self, other: &Self) -> Option<std::cmp::Ordering> {
+        Some(self.cmp(other))
+    }
+}
+
+impl<T: Ord> Ord for At<T> {
+    fn cmp(&self, other: &Self) -> std::cmp::Ordering {
+        self.value.cmp(&other.value)
+    }
+}
+
+/// The message with which a located parse stops (never shown to a user).
+const LOCATE_MARK: &str = "\u{0}covtrace-locate";
+
+thread_local! {
+    /// While parsing: the number the next [`At`] gets, and the one to stop at.
+    static PROBE: std::cell::Cell<(u32, Option<u32>)> = const { std::cell::Cell::new((0, None)) };
+}
+
+impl<'de, T: Deserialize<'de>> Deserialize<'de> for At<T> {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        let (ordinal, target) = PROBE.with(|p| {
+            let (n, t) = p.get();
+            p.set((n.saturating_add(1), t));
+            (n, t)
+        });
+        if target == Some(ordinal) {
+            return Err(D::Error::custom(LOCATE_MARK));
+        }
+        Ok(At {
+            value: T::deserialize(d)?,
+            ordinal,
+        })
+    }
 }
 
 impl SceneFile {
@@ -319,14 +372,54 @@ impl SceneFile {
     /// # Errors
     /// Malformed RON, unknown fields or variants, bad numbers: positioned.
     pub fn parse(text: &str, file: &str) -> Result<SceneFile, SceneError> {
+        Self::parse_probed(text, None).map_err(|e| SceneError {
+            file: file.to_string(),
+            at: Some((e.span.start.line, e.span.start.col)),
+            message: crate::error::one_line(&e.code.to_string()),
+        })
+    }
+
+    /// Parses with the [`At`] numbered `target` (if any) stopping the parser.
+    fn parse_probed(text: &str, target: Option<u32>) -> Result<SceneFile, ron::error::SpannedError> {
         let text = text.strip_prefix('\u{feff}').unwrap_or(text);
-        ron::Options::default()
+        PROBE.with(|p| p.set((0, target)));
+        let r = ron::Options::default()
             .with_default_extension(ron::extensions::Extensions::IMPLICIT_SOME)
-            .from_str(text)
-            .map_err(|e| SceneError {
-                file: file.to_string(),
-                at: Some((e.span.start.line, e.span.start.col)),
-                message: e.code.to_string(),
-            })
+            .from_str(text);
+        PROBE.with(|p| p.set((0, None)));
+        r
+    }
+
+    /// Line and column (1-based) where the [`At`] numbered `ordinal` is written in `text`
+    /// (the text this scene was parsed from), as the parser reports it.
+    pub fn locate(text: &str, ordinal: u32) -> Option<(usize, usize)> {
+        let text = text.strip_prefix('\u{feff}').unwrap_or(text);
+        match Self::parse_probed(text, Some(ordinal)) {
+            // The parser stops before the value, after the `:` or `,` that precedes it:
+            // the value starts at the next character that is not white space.
+            Err(e) if e.code.to_string().contains(LOCATE_MARK) => {
+                let (mut line, mut col) = (e.span.start.line, e.span.start.col);
+                let rest = text.lines().nth(line.checked_sub(1)?)?;
+                let mut chars = rest.chars().skip(col.saturating_sub(1)).peekable();
+                let mut lines = text.lines().skip(line);
+                loop {
+                    match chars.peek() {
+                        Some(c) if c.is_whitespace() => {
+                            chars.next();
+                            col += 1;
+                        }
+                        Some(_) => return Some((line, col)),
+                        None => {
+                            // The value is on a later line.
+                            let next = lines.next()?;
+                            line += 1;
+                            col = 1;
+                            chars = next.chars().skip(0).peekable();
+                        }
+                    }
+                }
+            }
+            _ => None,
+        }
     }
 }

@@ -7,7 +7,7 @@
 //! independent, so its expectation is the image's own power spectrum with no noise term
 //! (fireflies included). The measured image-space Σ is twice the normalised second moment
 //! of that power spectrum, less the Hann window's own: for a Gaussian the amplitude
-//! spectrum's Σ (PHYSICS.md §1) is exactly twice the power spectrum's, and the power
+//! spectrum's Σ (docs/physics.md §1) is exactly twice the power spectrum's, and the power
 //! moment is linear in the cross-spectrum, so noise cancels in expectation (the amplitude
 //! `√cross` of single noisy bins would not: it is biased upwards). The moment is taken over
 //! [`RINGS`] rings of frequency: the contiguous band of rings, around the most significant
@@ -34,7 +34,8 @@ use std::f64::consts::PI;
 use rustfft::FftPlanner;
 use rustfft::num_complex::Complex;
 
-use crate::render::{CovMaps, Image};
+use crate::covpass::CovMaps;
+use crate::film::Image;
 use crate::trace::luminance;
 
 /// Tile side (px) of the comparison.

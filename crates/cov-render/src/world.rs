@@ -9,8 +9,8 @@ use glam::DVec3;
 use crate::geometry::{Geometry, Prim, Shape};
 use crate::material::{Material, basis};
 use crate::scene::{
-    LightDesc, MAX_SCENE_BYTES, MAX_TRIANGLES, MaterialDesc, SceneError, SceneFile, ShapeDesc, V3,
-    position_of,
+    At, CameraDesc, LightDesc, MAX_SCENE_BYTES, MAX_TRIANGLES, MaterialDesc, SceneError, SceneFile,
+    ShapeDesc, V3,
 };
 
 fn v(a: V3) -> DVec3 {
@@ -304,7 +304,7 @@ impl World {
     /// # Errors
     /// An unreadable or oversized file, or any error of [`World::from_text`].
     pub fn load(path: &Path) -> Result<World, SceneError> {
-        let file = path.display().to_string();
+        let file = crate::error::one_line(&path.display().to_string());
         let err = |message: String| SceneError {
             file: file.clone(),
             at: None,
@@ -338,278 +338,306 @@ impl World {
     /// positioned line.
     pub fn from_text(text: &str, file: &str, dir: &Path) -> Result<World, SceneError> {
         let desc = SceneFile::parse(text, file)?;
-        let at = |needle: &str, message: String| SceneError {
+        let at = |ordinal: u32, message: String| SceneError {
             file: file.to_string(),
-            at: position_of(text, needle),
+            at: SceneFile::locate(text, ordinal),
             message,
         };
-        // Camera.
-        let c = &desc.camera;
-        let position = v(c.position);
-        let look = v(c.look_at) - position;
-        if look.length() <= 0.0 {
-            return Err(at("look_at", "the camera looks at its own position".into()));
+        let camera = camera(&desc.camera).map_err(|(o, m)| at(o, m))?;
+        let (materials, material_names) = materials(&desc).map_err(|(o, m)| at(o, m))?;
+        let mut prims = Vec::new();
+        let lights = lights(&desc, &mut prims).map_err(|(o, m)| at(o, m))?;
+        let names = Names(&material_names);
+        let any_velocity = shapes(&desc, &names, dir, &mut prims).map_err(|(o, m)| at(o, m))?
+            || camera.velocity != DVec3::ZERO;
+        let (t0, t1) = camera.shutter.unwrap_or((0.0, 0.0));
+        Ok(World {
+            file: file.to_string(),
+            has_motion: camera.shutter.is_some() && any_velocity,
+            camera,
+            materials,
+            material_names,
+            lights,
+            geometry: Geometry::new(prims, t0, t1),
+        })
+    }
+}
+
+/// A check's failure: the number of the [`At`] value it concerns, and the message.
+type Failure = (u32, String);
+
+/// The camera of a description.
+fn camera(c: &CameraDesc) -> Result<Camera, Failure> {
+    let position = v(c.position);
+    let look = v(c.look_at.value) - position;
+    if look.length() <= 0.0 {
+        return Err((c.look_at.ordinal, "the camera looks at its own position".into()));
+    }
+    let forward = look.normalize();
+    let up0 = c.up.as_ref().map_or(DVec3::Y, |u| v(u.value));
+    let right = forward.cross(up0);
+    if right.length() <= 1e-12 {
+        let o = c.up.as_ref().map_or(c.look_at.ordinal, |u| u.ordinal);
+        return Err((o, "`up` is parallel to the viewing direction".into()));
+    }
+    let right = right.normalize();
+    let up = right.cross(forward);
+    let fov_x = c.fov.value.0.to_radians();
+    if fov_x >= PI {
+        return Err((
+            c.fov.ordinal,
+            format!("fov must be below 180 degrees, got {}", c.fov.value.0),
+        ));
+    }
+    let (width, height) = (c.width.0, c.height.0);
+    let tan_x = (fov_x / 2.0).tan();
+    let tan_y = tan_x * height as f64 / width as f64;
+    let (lens_radius, focus_distance, focal_length) = match &c.lens {
+        Some(l) => {
+            let f = l.focal_length.map_or(0.05, |f| f.0);
+            let d = l.focus_distance.value.0;
+            if d <= f {
+                return Err((
+                    l.focus_distance.ordinal,
+                    format!("focus_distance {d} must exceed the focal length {f} (a real image)"),
+                ));
+            }
+            (l.aperture.0, d, f)
         }
-        let forward = look.normalize();
-        let up0 = c.up.map_or(DVec3::Y, v);
-        let right = forward.cross(up0);
-        if right.length() <= 1e-12 {
-            return Err(at("position", "`up` is parallel to the viewing direction".into()));
-        }
-        let right = right.normalize();
-        let up = right.cross(forward);
-        let fov_x = c.fov.0.to_radians();
-        if fov_x >= PI {
-            return Err(at(
-                "fov",
-                format!("fov must be below 180 degrees, got {}", c.fov.0),
+        None => (0.0, 1.0, 0.05),
+    };
+    let shutter = match &c.shutter {
+        Some(s) if s.close.value.0 > s.open.0 => Some((s.open.0, s.close.value.0)),
+        Some(s) => {
+            return Err((
+                s.close.ordinal,
+                format!(
+                    "the shutter closes ({}) before it opens ({})",
+                    s.close.value.0, s.open.0
+                ),
             ));
         }
-        let (width, height) = (c.width.0, c.height.0);
-        let tan_x = (fov_x / 2.0).tan();
-        let tan_y = tan_x * height as f64 / width as f64;
-        let (lens_radius, focus_distance, focal_length) = match &c.lens {
-            Some(l) => {
-                let f = l.focal_length.map_or(0.05, |f| f.0);
-                if l.focus_distance.0 <= f {
-                    return Err(at(
-                        "focus_distance",
-                        format!(
-                            "focus_distance {} must exceed the focal length {f} (a real image)",
-                            l.focus_distance.0
-                        ),
+        None => None,
+    };
+    Ok(Camera {
+        position,
+        right,
+        up,
+        forward,
+        tan_x,
+        tan_y,
+        fov_x,
+        width,
+        height,
+        lens_radius,
+        focus_distance,
+        focal_length,
+        shutter,
+        velocity: c.velocity.map_or(DVec3::ZERO, v),
+    })
+}
+
+/// The materials, and their names, in the order of the file's map.
+fn materials(desc: &SceneFile) -> Result<(Vec<Material>, Vec<String>), Failure> {
+    let mut materials = Vec::new();
+    let mut names = Vec::new();
+    for (name, m) in &desc.materials {
+        let mat = match *m {
+            MaterialDesc::Diffuse { albedo } => Material::Diffuse {
+                albedo: DVec3::from_array(albedo.0),
+            },
+            MaterialDesc::Phong { albedo, exponent } => Material::Phong {
+                albedo: DVec3::from_array(albedo.0),
+                exponent: exponent.0,
+            },
+            MaterialDesc::Ggx { albedo, alpha } => Material::Ggx {
+                albedo: DVec3::from_array(albedo.0),
+                alpha: alpha.0,
+            },
+        };
+        let albedo = match mat {
+            Material::Diffuse { albedo } | Material::Phong { albedo, .. } | Material::Ggx { albedo, .. } => {
+                albedo
+            }
+        };
+        if albedo.max_element() > 1.0 {
+            return Err((
+                name.ordinal,
+                format!(
+                    "material `{}`: an albedo above 1 reflects more than it receives",
+                    crate::echo(&name.value)
+                ),
+            ));
+        }
+        materials.push(mat);
+        names.push(name.value.clone());
+    }
+    Ok((materials, names))
+}
+
+/// The material names of a scene, for looking up the ones shapes refer to.
+struct Names<'a>(&'a [String]);
+
+impl Names<'_> {
+    /// The index of the material `name` refers to.
+    fn index(&self, name: &At<String>) -> Result<u32, Failure> {
+        self.0
+            .iter()
+            .position(|n| *n == name.value)
+            .map(|i| i as u32)
+            .ok_or_else(|| {
+                let known = if self.0.is_empty() {
+                    "none".to_string()
+                } else {
+                    self.0
+                        .iter()
+                        .map(|n| crate::echo(n))
+                        .collect::<Vec<_>>()
+                        .join(", ")
+                };
+                (
+                    name.ordinal,
+                    format!(
+                        "unknown material `{}`; the scene defines: {known}",
+                        crate::echo(&name.value)
+                    ),
+                )
+            })
+    }
+}
+
+/// The lights; emitters are also geometry (the camera sees them), added to `prims`.
+fn lights(desc: &SceneFile, prims: &mut Vec<Prim>) -> Result<Vec<Light>, Failure> {
+    let mut lights = Vec::new();
+    for l in &desc.lights.value {
+        let index = lights.len() as u32;
+        match l {
+            LightDesc::Rect {
+                corner,
+                edge_u,
+                edge_v,
+                radiance,
+            } => {
+                let (c0, eu, ev) = (v(*corner), v(edge_u.value), v(*edge_v));
+                let cr = eu.cross(ev);
+                if cr.length() <= 0.0 {
+                    return Err((
+                        edge_u.ordinal,
+                        "a Rect light's edges are parallel (zero area)".into(),
                     ));
                 }
-                (l.aperture.0, l.focus_distance.0, f)
-            }
-            None => (0.0, 1.0, 0.05),
-        };
-        let shutter = match &c.shutter {
-            Some(s) if s.close.0 > s.open.0 => Some((s.open.0, s.close.0)),
-            Some(s) => {
-                return Err(at(
-                    "close",
-                    format!(
-                        "the shutter closes ({}) before it opens ({})",
-                        s.close.0, s.open.0
-                    ),
-                ));
-            }
-            None => None,
-        };
-        let cam_velocity = c.velocity.map_or(DVec3::ZERO, v);
-        let camera = Camera {
-            position,
-            right,
-            up,
-            forward,
-            tan_x,
-            tan_y,
-            fov_x,
-            width,
-            height,
-            lens_radius,
-            focus_distance,
-            focal_length,
-            shutter,
-            velocity: cam_velocity,
-        };
-        // Materials.
-        let mut materials = Vec::new();
-        let mut material_names = Vec::new();
-        for (name, m) in &desc.materials {
-            let mat = match *m {
-                MaterialDesc::Diffuse { albedo } => Material::Diffuse {
-                    albedo: DVec3::from_array(albedo.0),
-                },
-                MaterialDesc::Phong { albedo, exponent } => Material::Phong {
-                    albedo: DVec3::from_array(albedo.0),
-                    exponent: exponent.0,
-                },
-                MaterialDesc::Ggx { albedo, alpha } => Material::Ggx {
-                    albedo: DVec3::from_array(albedo.0),
-                    alpha: alpha.0,
-                },
-            };
-            let albedo = match mat {
-                Material::Diffuse { albedo }
-                | Material::Phong { albedo, .. }
-                | Material::Ggx { albedo, .. } => albedo,
-            };
-            if albedo.max_element() > 1.0 {
-                return Err(at(
-                    &format!("\"{name}\""),
-                    format!("material `{name}`: an albedo above 1 reflects more than it receives"),
-                ));
-            }
-            materials.push(mat);
-            material_names.push(name.clone());
-        }
-        let material_index = |name: &str| -> Result<u32, SceneError> {
-            material_names
-                .iter()
-                .position(|n| n == name)
-                .map(|i| i as u32)
-                .ok_or_else(|| {
-                    at(
-                        &format!("\"{name}\""),
-                        format!(
-                            "unknown material `{}`; the scene defines: {}",
-                            crate::echo(name),
-                            if material_names.is_empty() {
-                                "none".into()
-                            } else {
-                                material_names.join(", ")
-                            }
-                        ),
-                    )
-                })
-        };
-        // Lights (emitters are also geometry, so the camera sees them).
-        let mut prims = Vec::new();
-        let mut lights = Vec::new();
-        for l in &desc.lights {
-            let index = lights.len() as u32;
-            match *l {
-                LightDesc::Rect {
-                    corner,
-                    edge_u,
-                    edge_v,
-                    radiance,
-                } => {
-                    let (c0, eu, ev) = (v(corner), v(edge_u), v(edge_v));
-                    let cr = eu.cross(ev);
-                    if cr.length() <= 0.0 {
-                        return Err(at("Rect", "a Rect light's edges are parallel (zero area)".into()));
-                    }
-                    lights.push(Light::Rect {
-                        corner: c0,
-                        eu,
-                        ev,
-                        n: cr.normalize(),
-                        area: cr.length(),
-                        radiance: DVec3::from_array(radiance.0),
-                    });
-                    for tri in quad_triangles(c0, eu, ev) {
-                        prims.push(Prim {
-                            shape: Shape::Triangle { v: tri, n: None },
-                            velocity: DVec3::ZERO,
-                            material: u32::MAX,
-                            light: Some(index),
-                        });
-                    }
-                }
-                LightDesc::Sphere {
-                    center,
-                    radius,
-                    radiance,
-                } => {
-                    lights.push(Light::Sphere {
-                        center: v(center),
-                        radius: radius.0,
-                        radiance: DVec3::from_array(radiance.0),
-                    });
+                lights.push(Light::Rect {
+                    corner: c0,
+                    eu,
+                    ev,
+                    n: cr.normalize(),
+                    area: cr.length(),
+                    radiance: DVec3::from_array(radiance.0),
+                });
+                for tri in quad_triangles(c0, eu, ev) {
                     prims.push(Prim {
-                        shape: Shape::Sphere {
-                            center: v(center),
-                            radius: radius.0,
-                        },
+                        shape: Shape::Triangle { v: tri, n: None },
                         velocity: DVec3::ZERO,
                         material: u32::MAX,
                         light: Some(index),
                     });
                 }
             }
+            LightDesc::Sphere {
+                center,
+                radius,
+                radiance,
+            } => {
+                lights.push(Light::Sphere {
+                    center: v(*center),
+                    radius: radius.0,
+                    radiance: DVec3::from_array(radiance.0),
+                });
+                prims.push(Prim {
+                    shape: Shape::Sphere {
+                        center: v(*center),
+                        radius: radius.0,
+                    },
+                    velocity: DVec3::ZERO,
+                    material: u32::MAX,
+                    light: Some(index),
+                });
+            }
         }
-        if lights.is_empty() {
-            return Err(at("lights", "the scene has no light (`lights: []`)".into()));
-        }
-        // Shapes.
-        let mut triangles = 0usize;
-        let mut any_velocity = cam_velocity != DVec3::ZERO;
-        for s in &desc.shapes {
-            match s {
-                ShapeDesc::Sphere {
-                    center,
-                    radius,
-                    material,
-                    velocity,
-                } => {
-                    let vel = velocity.map_or(DVec3::ZERO, v);
-                    any_velocity |= vel != DVec3::ZERO;
-                    prims.push(Prim {
-                        shape: Shape::Sphere {
-                            center: v(*center),
-                            radius: radius.0,
-                        },
-                        velocity: vel,
-                        material: material_index(material)?,
-                        light: None,
+    }
+    if lights.is_empty() {
+        return Err((
+            desc.lights.ordinal,
+            "the scene has no light (`lights: []`)".into(),
+        ));
+    }
+    Ok(lights)
+}
+
+/// The shapes, added to `prims`; whether any of them moves.
+fn shapes(desc: &SceneFile, names: &Names<'_>, dir: &Path, prims: &mut Vec<Prim>) -> Result<bool, Failure> {
+    let mut triangles = 0usize;
+    let mut any_velocity = false;
+    for s in &desc.shapes {
+        let (material, velocity) = match s {
+            ShapeDesc::Sphere {
+                material, velocity, ..
+            }
+            | ShapeDesc::Quad {
+                material, velocity, ..
+            }
+            | ShapeDesc::Mesh {
+                material, velocity, ..
+            } => (names.index(material)?, velocity.map_or(DVec3::ZERO, v)),
+        };
+        any_velocity |= velocity != DVec3::ZERO;
+        let mut push = |shape| {
+            prims.push(Prim {
+                shape,
+                velocity,
+                material,
+                light: None,
+            })
+        };
+        match s {
+            ShapeDesc::Sphere { center, radius, .. } => push(Shape::Sphere {
+                center: v(*center),
+                radius: radius.0,
+            }),
+            ShapeDesc::Quad {
+                corner,
+                edge_u,
+                edge_v,
+                ..
+            } => {
+                let (eu, ev) = (v(edge_u.value), v(*edge_v));
+                if eu.cross(ev).length() <= 0.0 {
+                    return Err((edge_u.ordinal, "a Quad's edges are parallel (zero area)".into()));
+                }
+                for tri in quad_triangles(v(*corner), eu, ev) {
+                    push(Shape::Triangle { v: tri, n: None });
+                }
+            }
+            ShapeDesc::Mesh {
+                obj,
+                translate,
+                scale,
+                ..
+            } => {
+                let tris = load_obj(&dir.join(&obj.value), MAX_TRIANGLES - triangles)
+                    .map_err(|e| (obj.ordinal, format!("OBJ `{}`: {e}", crate::echo(&obj.value))))?;
+                triangles += tris.len();
+                let (t, sc) = (translate.map_or(DVec3::ZERO, v), scale.map_or(1.0, |s| s.0));
+                for (p, n) in tris {
+                    push(Shape::Triangle {
+                        v: p.map(|q| q * sc + t),
+                        n,
                     });
-                }
-                ShapeDesc::Quad {
-                    corner,
-                    edge_u,
-                    edge_v,
-                    material,
-                    velocity,
-                } => {
-                    let vel = velocity.map_or(DVec3::ZERO, v);
-                    any_velocity |= vel != DVec3::ZERO;
-                    let m = material_index(material)?;
-                    if v(*edge_u).cross(v(*edge_v)).length() <= 0.0 {
-                        return Err(at("Quad", "a Quad's edges are parallel (zero area)".into()));
-                    }
-                    for tri in quad_triangles(v(*corner), v(*edge_u), v(*edge_v)) {
-                        prims.push(Prim {
-                            shape: Shape::Triangle { v: tri, n: None },
-                            velocity: vel,
-                            material: m,
-                            light: None,
-                        });
-                    }
-                }
-                ShapeDesc::Mesh {
-                    obj,
-                    material,
-                    translate,
-                    scale,
-                    velocity,
-                } => {
-                    let vel = velocity.map_or(DVec3::ZERO, v);
-                    any_velocity |= vel != DVec3::ZERO;
-                    let m = material_index(material)?;
-                    let needle = format!("\"{obj}\"");
-                    let tris = load_obj(&dir.join(obj), MAX_TRIANGLES - triangles)
-                        .map_err(|e| at(&needle, format!("OBJ `{}`: {e}", crate::echo(obj))))?;
-                    triangles += tris.len();
-                    let (t, sc) = (translate.map_or(DVec3::ZERO, v), scale.map_or(1.0, |s| s.0));
-                    for (p, n) in tris {
-                        prims.push(Prim {
-                            shape: Shape::Triangle {
-                                v: p.map(|q| q * sc + t),
-                                n,
-                            },
-                            velocity: vel,
-                            material: m,
-                            light: None,
-                        });
-                    }
                 }
             }
         }
-        let (t0, t1) = shutter.unwrap_or((0.0, 0.0));
-        let has_motion = shutter.is_some() && any_velocity;
-        Ok(World {
-            file: file.to_string(),
-            camera,
-            materials,
-            material_names,
-            lights,
-            geometry: Geometry::new(prims, t0, t1),
-            has_motion,
-        })
     }
+    Ok(any_velocity)
 }
 
 fn quad_triangles(c: DVec3, eu: DVec3, ev: DVec3) -> [[DVec3; 3]; 2] {
@@ -621,14 +649,18 @@ type ObjTriangle = ([DVec3; 3], Option<[DVec3; 3]>);
 /// Triangles (and vertex normals when the file has them) of an OBJ file, at most `limit`.
 fn load_obj(path: &Path, limit: usize) -> Result<Vec<ObjTriangle>, String> {
     if !path.is_file() {
-        return Err(format!("no such file: {}", path.display()));
+        return Err(format!(
+            "no such file: {}",
+            crate::error::one_line(&path.display().to_string())
+        ));
     }
     let opts = tobj::LoadOptions {
         triangulate: true,
         single_index: true,
         ..Default::default()
     };
-    let (models, _materials) = tobj::load_obj(path, &opts).map_err(|e| e.to_string())?;
+    let (models, _materials) =
+        tobj::load_obj(path, &opts).map_err(|e| crate::error::one_line(&e.to_string()))?;
     let mut out = Vec::new();
     for m in &models {
         let mesh = &m.mesh;

@@ -4,8 +4,10 @@
 
 use std::path::Path;
 
-use cov_render::World;
+use cov_render::adaptive::Guide;
 use cov_render::film::{Film, Filter, Gaussian};
+use cov_render::metrics::measure;
+use cov_render::{Method, RenderSettings, Renderer, World, covariance_maps};
 
 mod common;
 
@@ -70,20 +72,32 @@ fn scene(name: &str, w: u32, h: u32) -> World {
         .with_resolution(w, h)
 }
 
+/// A renderer of `world` with `method` at `spp`, seed 1, sharing `guide` when given.
+fn renderer<'w>(world: &'w World, method: Method, spp: f64, guide: Option<&Guide>) -> Renderer<'w> {
+    let settings = RenderSettings {
+        method,
+        spp,
+        ..RenderSettings::default()
+    };
+    let r = Renderer::new(world, settings).unwrap();
+    match guide {
+        Some(g) => r.with_guide(g.clone()).unwrap(),
+        None => r,
+    }
+}
+
 /// Every method runs on every bundled scene, spends its budget, and gives a finite,
-/// non-negative image; the covariance methods need the covariance pass.
+/// non-negative image; a covariance method without a guide traces the pass itself.
 #[test]
 fn every_method_runs_on_every_scene() {
-    use cov_render::bench::{Guide, Method, error, run};
-    use cov_render::render::covariance_maps_strided;
     for name in ["cornell.ron", "pool.ron", "glossy.ron"] {
         let world = scene(name, 24, 16);
-        let maps = covariance_maps_strided(&world, 1, 4, 1, None).unwrap();
+        let maps = covariance_maps(&world, 1, 4, 1, None).unwrap();
         assert_eq!(maps.stride, 4);
         let guide = Guide::new(&maps, 0.0);
         let reference = cov_render::render(&world, 16, 99);
         for m in Method::ALL {
-            let r = run(&world, m, 6.0, Some(&guide), 1, None).unwrap();
+            let r = renderer(&world, m, 6.0, Some(&guide)).render(None).unwrap();
             assert!(
                 r.image
                     .pixels
@@ -97,16 +111,118 @@ fn every_method_runs_on_every_scene() {
                 "{name} {m:?}: {} samples",
                 r.samples
             );
-            let e = error(&r.image, &reference).unwrap();
+            assert_eq!(r.passes, 1);
+            let e = measure(&r.image, &reference).unwrap();
             assert!(e.rmse.is_finite() && e.relmse.is_finite(), "{name} {m:?}");
             assert!(r.timing.total() > 0.0);
-            if m.uses_covariance() {
-                assert!(
-                    run(&world, m, 6.0, None, 1, None).is_err(),
-                    "{m:?} without a guide"
-                );
-            }
+            // Without a guide the renderer traces the same pass (same seed, same grid):
+            // the same image.
+            let mut own = renderer(&world, m, 6.0, None);
+            let again = own.render(None).unwrap();
+            assert_eq!(again.image, r.image, "{name} {m:?}");
+            assert_eq!(own.maps().is_some(), m.uses_covariance(), "{name} {m:?}");
         }
+    }
+}
+
+/// A guide of another size is refused with both sizes; settings out of range name the
+/// setting.
+#[test]
+fn guides_and_settings_are_checked() {
+    let world = scene("cornell.ron", 24, 16);
+    let small = scene("cornell.ron", 8, 8);
+    let guide = Guide::new(&covariance_maps(&small, 1, 4, 1, None).unwrap(), 0.0);
+    let e = Renderer::new(&world, RenderSettings::default())
+        .unwrap()
+        .with_guide(guide)
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("8x8 against 24x16"), "{e}");
+    for (s, name) in [
+        (
+            RenderSettings {
+                spp: 0.5,
+                ..RenderSettings::default()
+            },
+            "spp",
+        ),
+        (
+            RenderSettings {
+                spp: f64::NAN,
+                ..RenderSettings::default()
+            },
+            "spp",
+        ),
+        (
+            RenderSettings {
+                time: Some(-1.0),
+                ..RenderSettings::default()
+            },
+            "time",
+        ),
+        (
+            RenderSettings {
+                time: Some(f64::INFINITY),
+                ..RenderSettings::default()
+            },
+            "time",
+        ),
+        (
+            RenderSettings {
+                cov_paths: 0,
+                ..RenderSettings::default()
+            },
+            "cov_paths",
+        ),
+        (
+            RenderSettings {
+                cov_stride: 3,
+                ..RenderSettings::default()
+            },
+            "cov_stride",
+        ),
+    ] {
+        let e = Renderer::new(&world, s).unwrap_err().to_string();
+        assert!(e.starts_with(name) && !e.contains('\n'), "{e}");
+    }
+}
+
+/// A time-limited render adds passes that continue each pixel's sequence: the samples of
+/// `p` passes of `n` spp are the samples of one pass of `p·n` spp (the same box image up
+/// to the order of the additions).
+#[test]
+fn progressive_passes_continue_the_same_sequences() {
+    let world = scene("pool.ron", 16, 16);
+    let settings = RenderSettings {
+        method: Method::Uniform,
+        spp: 2.0,
+        time: Some(0.5),
+        ..RenderSettings::default()
+    };
+    let r = Renderer::new(&world, settings).unwrap().render(None).unwrap();
+    assert!(r.passes >= 2, "{} passes in 0.5 s", r.passes);
+    assert_eq!(r.samples, u64::from(r.passes) * 2 * 256);
+    assert!(r.timing.total() <= 0.5 * 1.5, "{:?}", r.timing);
+    let once = renderer(&world, Method::Uniform, f64::from(2 * r.passes), None)
+        .render(None)
+        .unwrap();
+    for (a, b) in r.image.pixels.iter().zip(&once.image.pixels) {
+        assert!(
+            (*a - *b).abs().max_element() <= 1e-9 * (1.0 + b.abs().max_element()),
+            "{a} vs {b}"
+        );
+    }
+    // Every method keeps passing within its time, and covariance ones trace once.
+    for m in Method::ALL {
+        let settings = RenderSettings {
+            method: m,
+            spp: 1.0,
+            time: Some(0.3),
+            ..RenderSettings::default()
+        };
+        let r = Renderer::new(&world, settings).unwrap().render(None).unwrap();
+        assert!(r.passes >= 2, "{m:?}: {} passes", r.passes);
+        assert!(r.image.pixels.iter().all(|p| p.is_finite()), "{m:?}");
     }
 }
 
@@ -114,16 +230,15 @@ fn every_method_runs_on_every_scene() {
 /// at 4 spp is closer to a 256-spp reference than the box filter at 4 spp.
 #[test]
 fn the_covariance_filter_lowers_the_error_of_a_noisy_image() {
-    use cov_render::bench::{Guide, Method, error, run};
-    use cov_render::render::covariance_maps_strided;
     let world = scene("cornell.ron", 64, 48);
     let reference = cov_render::render(&world, 256, 77);
-    let guide = Guide::new(&covariance_maps_strided(&world, 1, 4, 1, None).unwrap(), 0.0);
-    let uni = run(&world, Method::Uniform, 4.0, None, 1, None).unwrap();
-    let cov = run(&world, Method::CovFilter, 4.0, Some(&guide), 1, None).unwrap();
+    let uni = renderer(&world, Method::Uniform, 4.0, None).render(None).unwrap();
+    let cov = renderer(&world, Method::CovFilter, 4.0, None)
+        .render(None)
+        .unwrap();
     let (eu, ec) = (
-        error(&uni.image, &reference).unwrap(),
-        error(&cov.image, &reference).unwrap(),
+        measure(&uni.image, &reference).unwrap(),
+        measure(&cov.image, &reference).unwrap(),
     );
     assert!(
         ec.relmse < 0.5 * eu.relmse,

@@ -2,8 +2,8 @@
 
 use std::path::{Path, PathBuf};
 
-use cov_render::World;
-use cov_render::render::{covariance_maps, render, render_adaptive};
+use cov_render::film::Film;
+use cov_render::{World, covariance_maps, render};
 
 mod common;
 
@@ -39,8 +39,12 @@ fn every_bundled_scene_renders_the_same_on_one_and_two_threads() {
             a.pixels.iter().any(|p| p.max_element() > 0.0),
             "{name}: black image"
         );
-        let ma = pool(1).install(|| covariance_maps(&world, 2, 7)).unwrap();
-        let mb = pool(2).install(|| covariance_maps(&world, 2, 7)).unwrap();
+        let ma = pool(1)
+            .install(|| covariance_maps(&world, 2, 1, 7, None))
+            .unwrap();
+        let mb = pool(2)
+            .install(|| covariance_maps(&world, 2, 1, 7, None))
+            .unwrap();
         assert_eq!(ma, mb, "{name}: covariance maps differ with the thread count");
         // A different seed gives a different image (the seed is used).
         assert_ne!(a, pool(2).install(|| render(&world, 4, 8)), "{name}");
@@ -55,7 +59,9 @@ fn every_bundled_scene_renders_the_same_on_one_and_two_threads() {
 fn a_diffuse_plane_under_a_sphere_light_matches_the_closed_form() {
     let world = common::plane_under_sphere_light(0.5, 1, 1);
     let n = 20_000u32;
-    let (img, var) = render_adaptive(&world, &[n], 3, None);
+    let mut film = Film::new(1, 1);
+    film.render(&world, &[n], 3, f64::INFINITY, None);
+    let (img, var) = (film.box_image(), film.variance());
     let exact = 0.5 * (0.5f64 / 2.0).powi(2);
     let got = img.pixels[0].y;
     let stderr = (var[0] / n as f64).sqrt();
@@ -72,7 +78,7 @@ fn a_diffuse_plane_under_a_sphere_light_matches_the_closed_form() {
 #[test]
 fn a_two_pass_estimate_matches_the_closed_form() {
     let world = common::plane_under_sphere_light(0.5, 1, 1);
-    let mut film = cov_render::film::Film::new(1, 1);
+    let mut film = Film::new(1, 1);
     film.render(&world, &[3001], 5, f64::INFINITY, None);
     film.render(&world, &[9000], 5, f64::INFINITY, None);
     assert_eq!(film.count[0], 12001);
@@ -89,7 +95,7 @@ fn a_two_pass_estimate_matches_the_closed_form() {
 fn covariance_maps_are_finite_psd_and_see_the_scene() {
     for name in ["cornell.ron", "pool.ron", "glossy.ron"] {
         let world = load(name, 32, 24);
-        let maps = covariance_maps(&world, 4, 1).unwrap();
+        let maps = covariance_maps(&world, 4, 1, 1, None).unwrap();
         assert_eq!(maps.pixels.len(), 32 * 24);
         for p in &maps.pixels {
             let [a, b, c] = p.sigma;
@@ -112,11 +118,15 @@ fn covariance_maps_are_finite_psd_and_see_the_scene() {
     }
     // Motion and defocus enter the layout only where the scene has them.
     assert_eq!(
-        covariance_maps(&load("cornell.ron", 8, 6), 1, 1).unwrap().layout,
+        covariance_maps(&load("cornell.ron", 8, 6), 1, 1, 1, None)
+            .unwrap()
+            .layout,
         5
     );
     assert_eq!(
-        covariance_maps(&load("glossy.ron", 8, 6), 1, 1).unwrap().layout,
+        covariance_maps(&load("glossy.ron", 8, 6), 1, 1, 1, None)
+            .unwrap()
+            .layout,
         4
     );
 }

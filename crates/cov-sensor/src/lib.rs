@@ -1,7 +1,7 @@
 //! # cov-sensor: what a renderer does with Σ at the sensor
 //!
 //! At the sensor, Σ (with the aperture and shutter windows of cov-defocus and cov-motion
-//! applied) becomes per-pixel decisions (PHYSICS.md section 4):
+//! applied) becomes per-pixel decisions (docs/physics.md section 4):
 //!
 //! 1. the **pixel filter** is a window on the sensor position (rule 2), a Gaussian of std
 //!    `filter` pixels;

@@ -1,6 +1,6 @@
 //! Dense evaluation of the four rules in a generic real type: `f64` for the "plain"
 //! implementation, [`twofloat::TwoFloat`] (double-double, ~32 significant digits) for the
-//! reference. The formulas are the textbook ones of PHYSICS.md section 2, written once.
+//! reference. The formulas are the textbook ones of docs/physics.md section 2, written once.
 
 use std::ops::{Add, Div, Mul, Neg, Sub};
 

@@ -1,6 +1,6 @@
 //! # cov-travel: free-space travel
 //!
-//! **Primal definition** (PHYSICS.md section 3): travel by a distance `d` along the ray
+//! **Primal definition** (docs/physics.md section 3): travel by a distance `d` along the ray
 //! shears position by direction, `l'(x,u) = l(x − d·u, u)`, and `(y, v)` likewise in 3D.
 //! Time is unchanged (light is instantaneous at scene scales).
 //!

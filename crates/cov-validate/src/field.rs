@@ -7,7 +7,7 @@ use std::sync::Arc;
 /// A scalar function of the perturbation `z` (length `N`), shared between threads.
 pub type PrimalFn = Arc<dyn Fn(&[f64]) -> f64 + Send + Sync>;
 
-/// One primal operation `l → l'` (PHYSICS.md section 3 is written in these terms).
+/// One primal operation `l → l'` (docs/physics.md section 3 is written in these terms).
 #[derive(Clone)]
 pub enum Primal {
     /// Change of coordinates `l'(z) = l(A z)`, `A` row-major `N × N`.
@@ -67,7 +67,7 @@ impl Primal {
         Primal::Map(a)
     }
 
-    /// Travel by `d` (PHYSICS.md: `l'(x,u) = l(x − d·u, u)`, and `(y, v)` likewise in 3D).
+    /// Travel by `d` (docs/physics.md: `l'(x,u) = l(x − d·u, u)`, and `(y, v)` likewise in 3D).
     pub fn travel(n: usize, d: f64) -> Primal {
         let mut a = Self::identity(n);
         let (x, u) = (0, if n >= 4 { 2 } else { 1 });

@@ -1,7 +1,7 @@
 //! # cov-validate: the brute-force ground truth
 //!
 //! Builds the primal local light field of a chain directly from the definitions of
-//! `../shared/PHYSICS.md` section 3, as a composed function of `z` ([`Field`]): coordinate
+//! `docs/physics.md` section 3, as a composed function of `z` ([`Field`]): coordinate
 //! maps, products with windows (smooth or hard), convolutions with lobes and integrations
 //! by quadrature. [`measure`] samples it on a grid under a Gaussian window, FFTs it
 //! (rustfft) and returns the normalised second moments of `|l̂|` minus the window's own

@@ -82,7 +82,7 @@ impl Grid {
     }
 }
 
-/// Measures Σ of `field` on `grid` (PHYSICS.md section 5): samples `l·W`, FFTs it, takes
+/// Measures Σ of `field` on `grid` (docs/physics.md section 5): samples `l·W`, FFTs it, takes
 /// the normalised second moments of `|l̂|` and subtracts the window's covariance.
 ///
 /// # Errors

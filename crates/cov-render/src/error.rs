@@ -1,0 +1,90 @@
+//! The renderer's errors: one type, each variant one line that says what was wrong and
+//! where.
+
+use crate::scene::SceneError;
+
+/// What can go wrong when rendering, in one line.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum RenderError {
+    /// The scene file (positioned: `file:line:col: message`).
+    #[error(transparent)]
+    Scene(#[from] SceneError),
+    /// An operator of the covariance pass rejected what the scene gave it.
+    #[error("covariance path at pixel ({x}, {y}): {message}")]
+    Covariance {
+        /// Pixel column.
+        x: u32,
+        /// Pixel row.
+        y: u32,
+        /// The operator's error.
+        message: String,
+    },
+    /// The covariance pass could not set up the camera's operators.
+    #[error("covariance camera: {0}")]
+    Camera(String),
+    /// A setting out of range, named as the caller wrote it.
+    #[error("{name} must be {expected}, got {got}")]
+    Setting {
+        /// The setting (`--spp`, `cov_stride`, …).
+        name: &'static str,
+        /// What it must be.
+        expected: String,
+        /// What it was.
+        got: String,
+    },
+    /// Two images (or an image and its maps) of different sizes.
+    #[error("{what}: {a_w}x{a_h} against {b_w}x{b_h}")]
+    Size {
+        /// What was compared.
+        what: &'static str,
+        /// First width.
+        a_w: u32,
+        /// First height.
+        a_h: u32,
+        /// Second width.
+        b_w: u32,
+        /// Second height.
+        b_h: u32,
+    },
+    /// A file could not be read or written.
+    #[error("{path}: {message}")]
+    File {
+        /// The file, as given.
+        path: String,
+        /// What went wrong.
+        message: String,
+    },
+}
+
+impl RenderError {
+    /// A file error for `path`.
+    pub fn file(path: &std::path::Path, e: impl std::fmt::Display) -> RenderError {
+        RenderError::File {
+            path: one_line(&path.display().to_string()),
+            message: one_line(&e.to_string()),
+        }
+    }
+
+    /// A setting error.
+    pub fn setting(
+        name: &'static str,
+        expected: impl Into<String>,
+        got: impl std::fmt::Display,
+    ) -> RenderError {
+        RenderError::Setting {
+            name,
+            expected: expected.into(),
+            got: crate::echo(&got.to_string()),
+        }
+    }
+}
+
+/// `s` on one line: line breaks and other control characters escaped.
+pub(crate) fn one_line(s: &str) -> String {
+    s.chars()
+        .flat_map(|c| {
+            let esc = c.is_control().then(|| c.escape_default());
+            esc.into_iter().flatten().chain((!c.is_control()).then_some(c))
+        })
+        .collect()
+}

@@ -1,0 +1,135 @@
+//! What a render writes: the linear EXR and its tone-mapped PNG, the covariance maps as
+//! pictures and JSON, and the colour map they share.
+
+use std::path::Path;
+
+use glam::DVec3;
+
+use crate::RenderError;
+use crate::adaptive::{content, filter_std};
+use crate::covpass::CovMaps;
+use crate::film::Image;
+
+/// sRGB encoding of a linear value in `[0, 1]`.
+fn srgb(c: f64) -> u8 {
+    let c = if c.is_finite() { c.clamp(0.0, 1.0) } else { 0.0 };
+    let s = if c <= 0.0031308 {
+        12.92 * c
+    } else {
+        1.055 * c.powf(1.0 / 2.4) - 0.055
+    };
+    (s * 255.0 + 0.5) as u8
+}
+
+/// The tone-mapped sRGB picture of `img` (Reinhard on luminance, which keeps hues;
+/// exposure 1).
+pub fn tonemap(img: &Image) -> image::RgbImage {
+    image::RgbImage::from_fn(img.width, img.height, |x, y| {
+        let p = img.get(x, y);
+        let l = crate::trace::luminance(p).max(0.0);
+        let s = if l > 0.0 { 1.0 / (1.0 + l) } else { 1.0 };
+        image::Rgb([srgb(p.x * s), srgb(p.y * s), srgb(p.z * s)])
+    })
+}
+
+/// Writes `img` as linear OpenEXR (`.exr`) and a tone-mapped sRGB PNG beside it.
+///
+/// # Errors
+/// The files cannot be written.
+pub fn write_image(img: &Image, exr: &Path, png: &Path) -> Result<(), RenderError> {
+    let raw: Vec<f32> = img
+        .pixels
+        .iter()
+        .flat_map(|p| [p.x as f32, p.y as f32, p.z as f32])
+        .collect();
+    let hdr = image::Rgb32FImage::from_raw(img.width, img.height, raw)
+        .ok_or_else(|| RenderError::file(exr, "the image's pixels do not match its size"))?;
+    hdr.save(exr).map_err(|e| RenderError::file(exr, e))?;
+    tonemap(img).save(png).map_err(|e| RenderError::file(png, e))
+}
+
+/// Reads a linear RGB image (an EXR written by [`write_image`]).
+///
+/// # Errors
+/// The file cannot be read or decoded.
+pub fn read_image(path: &Path) -> Result<Image, RenderError> {
+    let img = image::open(path)
+        .map_err(|e| RenderError::file(path, e))?
+        .into_rgb32f();
+    Ok(Image {
+        width: img.width(),
+        height: img.height(),
+        pixels: img
+            .pixels()
+            .map(|p| DVec3::new(f64::from(p[0]), f64::from(p[1]), f64::from(p[2])))
+            .collect(),
+    })
+}
+
+/// A perceptually ordered colour map (dark blue → yellow) for `t` in `[0, 1]`.
+pub fn colormap(t: f64) -> [u8; 3] {
+    let t = if t.is_finite() { t.clamp(0.0, 1.0) } else { 0.0 };
+    // A few stops of viridis.
+    const STOPS: [[f64; 3]; 5] = [
+        [68.0, 1.0, 84.0],
+        [59.0, 82.0, 139.0],
+        [33.0, 145.0, 140.0],
+        [94.0, 201.0, 98.0],
+        [253.0, 231.0, 37.0],
+    ];
+    let x = t * (STOPS.len() - 1) as f64;
+    let i = (x.floor() as usize).min(STOPS.len() - 2);
+    let f = x - i as f64;
+    let c = |k: usize| (STOPS[i][k] * (1.0 - f) + STOPS[i + 1][k] * f).round() as u8;
+    [c(0), c(1), c(2)]
+}
+
+/// Writes the density map (samples per pixel, log scale from 1 to the largest) and the
+/// filter map (reconstruction filter std of the content, [`content`], 0 to `max_filter`
+/// px) as PNGs, and the maps as JSON.
+///
+/// # Errors
+/// The files cannot be written.
+pub fn write_maps(
+    maps: &CovMaps,
+    pixel_filter: f64,
+    max_filter: f64,
+    density: &Path,
+    filter: &Path,
+    json: &Path,
+) -> Result<(), RenderError> {
+    let hi = maps
+        .pixels
+        .iter()
+        .map(|p| p.spp)
+        .fold(1.0f64, f64::max)
+        .ln()
+        .max(1e-9);
+    let w = maps.width;
+    let img = image::RgbImage::from_fn(maps.width, maps.height, |x, y| {
+        let p = &maps.pixels[(y * w + x) as usize];
+        image::Rgb(colormap(p.spp.max(1.0).ln() / hi))
+    });
+    img.save(density).map_err(|e| RenderError::file(density, e))?;
+    let stds: Vec<f64> = maps
+        .pixels
+        .iter()
+        .map(|p| filter_std(content(p.sigma, pixel_filter), max_filter))
+        .collect();
+    let img = image::RgbImage::from_fn(maps.width, maps.height, |x, y| {
+        image::Rgb(colormap(stds[(y * w + x) as usize] / max_filter))
+    });
+    img.save(filter).map_err(|e| RenderError::file(filter, e))?;
+    let data = serde_json::json!({
+        "width": maps.width,
+        "height": maps.height,
+        "layout": maps.layout,
+        "paths_per_block": maps.paths_per_block,
+        "block_px": maps.stride,
+        "units": { "sigma": "(cycles/px)^2, [xx, xy, yy] per pixel", "spp": "samples per pixel over pixel x lens x time" },
+        "sigma": maps.pixels.iter().flat_map(|p| p.sigma).collect::<Vec<f64>>(),
+        "spp": maps.pixels.iter().map(|p| p.spp).collect::<Vec<f64>>(),
+    });
+    let text = serde_json::to_string(&data).map_err(|e| RenderError::file(json, e))?;
+    std::fs::write(json, text).map_err(|e| RenderError::file(json, e))
+}

@@ -1,0 +1,460 @@
+//! The renderer: one implementation of every sampling and reconstruction method, used by
+//! `covtrace render`, `render-bench` and `render-check` alike.
+//!
+//! A [`Renderer`] holds a [`World`] and its [`RenderSettings`]: the method, the average
+//! budget of samples per pixel, the seed, an optional time limit, and the covariance
+//! pass's grid. [`Renderer::render`] traces the covariance pass when the method needs it,
+//! renders the samples in one or more passes over each pixel's own Sobol sequence
+//! ([`crate::sampler`]), and reconstructs the image:
+//!
+//! | method | samples per pixel | reconstruction |
+//! |---|---|---|
+//! | `uniform` | the budget, everywhere | box (a pixel's own samples) |
+//! | `gauss` | the budget, everywhere | a fixed Gaussian of [`FIXED_STD`] px |
+//! | `variance` | a pilot pass, then the rest ∝ relative variance | box |
+//! | `cov-density` | ∝ the predicted density over pixel × lens × time | box |
+//! | `cov-filter` | the budget, everywhere | each pixel's Gaussian from Σ |
+//! | `cov` (default) | ∝ the predicted density | each pixel's Gaussian from Σ |
+//!
+//! With a time limit ([`RenderSettings::time`]) the renderer keeps adding passes of the
+//! budget, each continuing every pixel's sequence, while the next pass is expected to end
+//! within the limit; the image is reconstructed once, from all of them.
+//!
+//! ```no_run
+//! use cov_render::{Method, RenderSettings, Renderer, World};
+//!
+//! let world = World::load(std::path::Path::new("examples/scenes/cornell.ron"))?;
+//! let settings = RenderSettings { method: Method::Cov, spp: 16.0, ..RenderSettings::default() };
+//! let out = Renderer::new(&world, settings)?.render(None)?;
+//! println!("{} samples in {:.2} s", out.samples, out.timing.total());
+//! # Ok::<(), Box<dyn std::error::Error>>(())
+//! ```
+//!
+//! Determinism: pixels draw from their own sequences and the covariance pass's tiles from
+//! generators seeded by the seed and the tile; results are added in a fixed order, so an
+//! image does not depend on the number of threads.
+
+use std::time::Instant;
+
+use crate::RenderError;
+use crate::adaptive::{Guide, MAX_RATIO, adapted_filters, allocate, relative_variance};
+use crate::covpass::{CovMaps, MAX_COV_PATHS, STRIDES, covariance_maps};
+use crate::film::{Film, Filter, Gaussian, Image, MAX_SPP, Progress};
+use crate::world::World;
+
+/// Std of the fixed Gaussian filter of the `gauss` baseline (px).
+pub const FIXED_STD: f64 = 1.0;
+/// Longest time limit a render accepts (s): one week.
+pub const MAX_TIME: f64 = 7.0 * 24.0 * 3600.0;
+
+/// A sampling and reconstruction method.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Method {
+    /// Uniform samples, box filter: plain Monte Carlo.
+    Uniform,
+    /// Uniform samples, a fixed Gaussian filter of [`FIXED_STD`] px.
+    Gauss,
+    /// Two passes: a pilot, then samples ∝ the pilot's relative variance (box filter).
+    Variance,
+    /// Samples ∝ the covariance density, box filter (ablation).
+    CovDensity,
+    /// Uniform samples, the covariance filter (ablation).
+    CovFilter,
+    /// Samples ∝ the covariance density and the covariance filter.
+    Cov,
+}
+
+impl Method {
+    /// Every method, baselines first.
+    pub const ALL: [Method; 6] = [
+        Method::Uniform,
+        Method::Gauss,
+        Method::Variance,
+        Method::CovDensity,
+        Method::CovFilter,
+        Method::Cov,
+    ];
+
+    /// Its name in tables and on the command line.
+    pub fn name(self) -> &'static str {
+        match self {
+            Method::Uniform => "uniform",
+            Method::Gauss => "gauss",
+            Method::Variance => "variance",
+            Method::CovDensity => "cov-density",
+            Method::CovFilter => "cov-filter",
+            Method::Cov => "cov",
+        }
+    }
+
+    /// The method of a name.
+    pub fn from_name(s: &str) -> Option<Method> {
+        Method::ALL.into_iter().find(|m| m.name() == s)
+    }
+
+    /// Whether it needs the covariance pass.
+    pub fn uses_covariance(self) -> bool {
+        matches!(self, Method::CovDensity | Method::CovFilter | Method::Cov)
+    }
+}
+
+/// What to render and how.
+#[derive(Clone, Debug, PartialEq)]
+pub struct RenderSettings {
+    /// The sampling and reconstruction method.
+    pub method: Method,
+    /// Average samples per pixel of one pass (1 to [`MAX_SPP`]).
+    pub spp: f64,
+    /// Seed of the random numbers.
+    pub seed: u64,
+    /// Keep adding passes until this many seconds (covariance pass included) are spent;
+    /// `None`: one pass.
+    pub time: Option<f64>,
+    /// Covariance paths per block of the covariance grid (1 to [`MAX_COV_PATHS`]).
+    pub cov_paths: u32,
+    /// Side of the covariance grid's blocks (px, one of [`STRIDES`]).
+    pub cov_stride: u32,
+    /// Every sample's luminance is clamped to this (colour scaled down); `∞` for an
+    /// unbiased image. A finite clamp is biased: for measuring the spectrum of a reference
+    /// without its rare caustic fireflies (`render-check`), never for an image.
+    pub max_luminance: f64,
+}
+
+impl Default for RenderSettings {
+    /// Covariance tracing (`cov`) at 16 samples per pixel, seed 1, one pass, one
+    /// covariance path per 4×4 block.
+    fn default() -> RenderSettings {
+        RenderSettings {
+            method: Method::Cov,
+            spp: 16.0,
+            seed: 1,
+            time: None,
+            cov_paths: 1,
+            cov_stride: 4,
+            max_luminance: f64::INFINITY,
+        }
+    }
+}
+
+impl RenderSettings {
+    /// Checks every setting's range.
+    ///
+    /// # Errors
+    /// The first setting out of range, named as in [`RenderSettings`].
+    pub fn check(&self) -> Result<(), RenderError> {
+        let max = f64::from(MAX_SPP);
+        if !(self.spp.is_finite() && (1.0..=max).contains(&self.spp)) {
+            return Err(RenderError::setting(
+                "spp",
+                format!("1 to {MAX_SPP} samples per pixel"),
+                self.spp,
+            ));
+        }
+        if let Some(t) = self.time
+            && !(t.is_finite() && t > 0.0 && t <= MAX_TIME)
+        {
+            return Err(RenderError::setting(
+                "time",
+                format!("more than 0 and at most {MAX_TIME} s"),
+                t,
+            ));
+        }
+        if !(1..=MAX_COV_PATHS).contains(&self.cov_paths) {
+            return Err(RenderError::setting(
+                "cov_paths",
+                format!("1 to {MAX_COV_PATHS}"),
+                self.cov_paths,
+            ));
+        }
+        if !STRIDES.contains(&self.cov_stride) {
+            return Err(RenderError::setting(
+                "cov_stride",
+                format!("one of {STRIDES:?}"),
+                self.cov_stride,
+            ));
+        }
+        if self.max_luminance.is_nan() || self.max_luminance <= 0.0 {
+            return Err(RenderError::setting(
+                "max_luminance",
+                "more than 0",
+                self.max_luminance,
+            ));
+        }
+        Ok(())
+    }
+}
+
+/// A rendered image and how it was made.
+#[derive(Clone, Debug)]
+pub struct Rendered {
+    /// The method.
+    pub method: Method,
+    /// Average samples per pixel of one pass.
+    pub budget: f64,
+    /// Passes rendered (1 without a time limit).
+    pub passes: u32,
+    /// Samples taken in all.
+    pub samples: u64,
+    /// The reconstructed image.
+    pub image: Image,
+    /// The samples, as the film holds them (sums, counts, luminance moments).
+    pub film: Film,
+    /// Where the time went.
+    pub timing: Timing,
+}
+
+/// Renders a world with one method: see the module docs.
+#[derive(Debug)]
+pub struct Renderer<'w> {
+    world: &'w World,
+    settings: RenderSettings,
+    maps: Option<CovMaps>,
+    guide: Option<Guide>,
+}
+
+impl<'w> Renderer<'w> {
+    /// A renderer of `world` with `settings`.
+    ///
+    /// # Errors
+    /// A setting out of range ([`RenderSettings::check`]).
+    pub fn new(world: &'w World, settings: RenderSettings) -> Result<Renderer<'w>, RenderError> {
+        settings.check()?;
+        Ok(Renderer {
+            world,
+            settings,
+            maps: None,
+            guide: None,
+        })
+    }
+
+    /// The settings.
+    pub fn settings(&self) -> &RenderSettings {
+        &self.settings
+    }
+
+    /// Uses `guide` (made from this world's covariance maps at the same resolution, by
+    /// another renderer or an earlier run) instead of tracing the pass again; its time
+    /// is counted in every render's [`Timing::covariance`].
+    ///
+    /// # Errors
+    /// A guide of another size.
+    pub fn with_guide(mut self, guide: Guide) -> Result<Renderer<'w>, RenderError> {
+        let (w, h) = (self.world.camera.width, self.world.camera.height);
+        let n = w as usize * h as usize;
+        if guide.matched.len() != n || guide.density.len() != n {
+            return Err(RenderError::Size {
+                what: "a covariance guide against the image",
+                a_w: guide.width,
+                a_h: guide.height,
+                b_w: w,
+                b_h: h,
+            });
+        }
+        self.guide = Some(guide);
+        Ok(self)
+    }
+
+    /// Traces the covariance pass (once; later calls keep the first maps) and makes the
+    /// guide from it, reporting each finished tile to `progress`.
+    ///
+    /// # Errors
+    /// An operator that rejects what the scene gives it, with the pixel.
+    pub fn trace_covariance(&mut self, progress: Progress<'_>) -> Result<&CovMaps, RenderError> {
+        let maps = match self.maps.take() {
+            Some(m) => m,
+            None => {
+                let s = &self.settings;
+                let (maps, secs) =
+                    timed(|| covariance_maps(self.world, s.cov_paths, s.cov_stride, s.seed, progress));
+                let maps = maps?;
+                if self.guide.is_none() {
+                    self.guide = Some(Guide::new(&maps, secs));
+                }
+                maps
+            }
+        };
+        Ok(self.maps.insert(maps))
+    }
+
+    /// How many times one [`Renderer::render`] without a time limit calls its progress
+    /// callback: once per tile of every pass, and of the covariance pass when it is still
+    /// to be traced.
+    pub fn progress_len(&self) -> usize {
+        let tiles = crate::film::tile_count(self.world);
+        let s = &self.settings;
+        let cov = usize::from(s.method.uses_covariance() && self.guide.is_none());
+        let pilot = (s.spp / 4.0).floor().max(2.0);
+        let passes = if s.method == Method::Variance && s.spp >= pilot + 1.0 {
+            2
+        } else {
+            1
+        };
+        tiles * (cov + passes)
+    }
+
+    /// The covariance maps, once traced.
+    pub fn maps(&self) -> Option<&CovMaps> {
+        self.maps.as_ref()
+    }
+
+    /// The guide (sample density and matched filters), once traced or given.
+    pub fn guide(&self) -> Option<&Guide> {
+        self.guide.as_ref()
+    }
+
+    /// Renders the image: the covariance pass first when the method needs it and no guide
+    /// was given, then the passes, then the reconstruction. `progress` is called once per
+    /// finished tile of every pass (the covariance pass's tiles included).
+    ///
+    /// # Errors
+    /// The covariance pass's errors ([`Renderer::trace_covariance`]).
+    pub fn render(&mut self, progress: Progress<'_>) -> Result<Rendered, RenderError> {
+        let start = Instant::now();
+        let method = self.settings.method;
+        if method.uses_covariance() && self.guide.is_none() {
+            self.trace_covariance(progress)?;
+        }
+        let guide = if method.uses_covariance() {
+            self.guide.as_ref()
+        } else {
+            None
+        };
+        let mut timing = Timing {
+            covariance: guide.map_or(0.0, |g| g.secs),
+            ..Timing::default()
+        };
+        let (world, s) = (self.world, &self.settings);
+        let (w, h) = (world.camera.width, world.camera.height);
+        let n = w as usize * h as usize;
+        let total = s.spp * n as f64;
+        let hi = ((s.spp * MAX_RATIO).ceil() as u32).clamp(1, MAX_SPP);
+        let mut film = Film::new(w, h);
+        let sample = |film: &mut Film, counts: &[u32], timing: &mut Timing| {
+            timing.sample(|| film.render(world, counts, s.seed, s.max_luminance, progress));
+        };
+        // The first pass.
+        let (mut counts, t) = timed(|| match (method, guide) {
+            (Method::CovDensity | Method::Cov, Some(g)) => {
+                let lo = ((s.spp / 4.0).floor() as u32).max(1);
+                allocate(&g.density, total, lo, hi)
+            }
+            _ => allocate(&vec![1.0; n], total, 1, MAX_SPP),
+        });
+        match method {
+            Method::Variance => {
+                // A pilot of a quarter of the budget (at least 2 samples, for a variance),
+                // then counts ∝ the relative standard deviation (blurred over 3×3 pixels),
+                // at least the pilot: the allocation that minimises the summed relative
+                // variance Σ σᵢ²/(nᵢ(μᵢ² + ε)) for a fixed total.
+                let pilot = (s.spp / 4.0).floor().max(2.0);
+                if s.spp < pilot + 1.0 {
+                    sample(&mut film, &counts, &mut timing);
+                } else {
+                    sample(&mut film, &vec![pilot as u32; n], &mut timing);
+                    let p = pilot as u32;
+                    let (rest, secs) = timed(|| {
+                        allocate(&relative_variance(&film), total, p, hi.max(p))
+                            .into_iter()
+                            .map(|c| c.saturating_sub(p))
+                            .collect::<Vec<u32>>()
+                    });
+                    timing.allocation += secs;
+                    sample(&mut film, &rest, &mut timing);
+                }
+            }
+            _ => {
+                if matches!(method, Method::CovDensity | Method::Cov) {
+                    timing.allocation += t;
+                }
+                sample(&mut film, &counts, &mut timing);
+            }
+        }
+        // More passes while the next one is expected to end within the time limit.
+        let mut passes = 1u32;
+        if let Some(limit) = s.time {
+            loop {
+                let pass_secs = timing.sampling / f64::from(passes);
+                let highest = film.count.iter().copied().max().unwrap_or(0);
+                let elapsed = start.elapsed().as_secs_f64();
+                if elapsed + pass_secs > limit || u64::from(highest) + u64::from(hi) > u64::from(MAX_SPP) {
+                    break;
+                }
+                if method == Method::Variance {
+                    let (c, secs) = timed(|| allocate(&relative_variance(&film), total, 1, hi));
+                    timing.allocation += secs;
+                    counts = c;
+                }
+                sample(&mut film, &counts, &mut timing);
+                passes += 1;
+            }
+        }
+        let (image, secs) = timed(|| {
+            let filter = match (method, guide) {
+                (Method::Gauss, _) => Filter::Fixed(Gaussian::isotropic(FIXED_STD)),
+                (Method::CovFilter | Method::Cov, Some(g)) => Filter::PerPixel(adapted_filters(g, &film)),
+                _ => Filter::Box,
+            };
+            film.image(&filter)
+        });
+        timing.reconstruction += secs;
+        Ok(Rendered {
+            method,
+            budget: s.spp,
+            passes,
+            samples: film.count.iter().map(|&c| u64::from(c)).sum(),
+            image,
+            film,
+            timing,
+        })
+    }
+}
+
+/// A uniform render of `spp` samples per pixel with the box filter: plain Monte Carlo
+/// ([`Method::Uniform`] through [`Renderer`]); `spp` is clamped to 1..=[`MAX_SPP`].
+pub fn render(world: &World, spp: u32, seed: u64) -> Image {
+    let settings = RenderSettings {
+        method: Method::Uniform,
+        spp: f64::from(spp.clamp(1, MAX_SPP)),
+        seed,
+        ..RenderSettings::default()
+    };
+    // Uniform settings in range never fail: no covariance pass runs.
+    Renderer::new(world, settings)
+        .and_then(|mut r| r.render(None))
+        .map_or_else(
+            |_| Image::new(world.camera.width, world.camera.height),
+            |r| r.image,
+        )
+}
+
+/// Runs `f`, returning its result and the seconds it took.
+pub fn timed<T>(f: impl FnOnce() -> T) -> (T, f64) {
+    let t = Instant::now();
+    let r = f();
+    (r, t.elapsed().as_secs_f64())
+}
+
+/// Where a run spent its time (wall-clock seconds).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Timing {
+    /// The covariance pass (with the filters), for the covariance methods.
+    pub covariance: f64,
+    /// Tracing samples (every pass).
+    pub sampling: f64,
+    /// Reconstructing the image from the film (the filters' splat).
+    pub reconstruction: f64,
+    /// Allocating samples to pixels (the variance method's analysis of its pilot pass).
+    pub allocation: f64,
+}
+
+impl Timing {
+    /// The run's total.
+    pub fn total(&self) -> f64 {
+        self.covariance + self.sampling + self.reconstruction + self.allocation
+    }
+
+    fn sample(&mut self, f: impl FnOnce()) {
+        let ((), secs) = timed(f);
+        self.sampling += secs;
+    }
+}
