@@ -109,8 +109,33 @@ fn emit(line: &str) -> Result<(), String> {
     }
 }
 
+/// Clap's message for a bad command line, in one line: its error and tips, without the
+/// usage block (`covtrace X --help` shows that).
+fn one_line_usage_error(e: &clap::Error) -> String {
+    let text = e.render().to_string();
+    let parts: Vec<String> = text
+        .lines()
+        .take_while(|l| !l.starts_with("Usage:"))
+        .map(str::trim)
+        .filter(|l| !l.is_empty() && !l.starts_with("For more information"))
+        .map(|l| {
+            let l = l.strip_prefix("error: ").unwrap_or(l);
+            l.strip_prefix("tip: ").unwrap_or(l).to_string()
+        })
+        .collect();
+    format!("{} (see --help)", parts.join("; "))
+}
+
 fn main() -> ExitCode {
-    match run(Cli::parse()) {
+    let cli = match Cli::try_parse() {
+        Ok(cli) => cli,
+        Err(e) if !e.use_stderr() => e.exit(),
+        Err(e) => {
+            eprintln!("covtrace: {}", one_line_usage_error(&e));
+            return ExitCode::from(2);
+        }
+    };
+    match run(cli) {
         Ok(()) => ExitCode::SUCCESS,
         Err(message) => {
             eprintln!("covtrace: {message}");

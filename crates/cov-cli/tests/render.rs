@@ -125,3 +125,145 @@ fn bad_scene_files_give_one_positioned_line() {
     let out = covtrace(&["render", "examples/scenes/pool.ron", "--spp", "0"]);
     assert_eq!(out.status.code(), Some(2));
 }
+
+/// Renders `scene` at 32×24 with `extra` arguments into `name.exr`; returns the EXR's
+/// path and stdout.
+fn render(scene: &str, name: &str, extra: &[&str]) -> (PathBuf, String) {
+    let exr = tmp(&format!("{name}.exr"));
+    let mut args = vec![
+        "render",
+        scene,
+        "--size",
+        "32x24",
+        "-o",
+        exr.to_str().expect("utf-8 path"),
+    ];
+    args.extend_from_slice(extra);
+    let out = covtrace(&args);
+    assert!(
+        out.status.success(),
+        "{name}: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    (exr, String::from_utf8_lossy(&out.stdout).into_owned())
+}
+
+/// The EXR's pixels (f32, as written).
+fn pixels(exr: &std::path::Path) -> Vec<f32> {
+    image::open(exr).expect("exr reads").into_rgb32f().into_raw()
+}
+
+/// `--method` picks the method: covariance tracing by default (with the maps), plain
+/// Monte Carlo without a covariance pass, and each method its own image.
+#[test]
+fn method_picks_the_method_and_covariance_is_the_default() {
+    let scene = "examples/scenes/cornell.ron";
+    let (def, out) = render(scene, "default", &["--spp", "4"]);
+    assert!(
+        out.contains("render: cov,") && out.contains("covariance: 1 path(s) per 4×4 block"),
+        "{out}"
+    );
+    let (cov, _) = render(scene, "cov", &["--spp", "4", "--method", "cov"]);
+    assert_eq!(pixels(&def), pixels(&cov));
+    let (uni, out) = render(scene, "uniform", &["--spp", "4", "--method", "uniform"]);
+    assert!(
+        out.contains("render: uniform,") && !out.contains("covariance:"),
+        "{out}"
+    );
+    assert!(!out.contains("density.png"), "{out}");
+    assert_ne!(pixels(&uni), pixels(&cov));
+    for m in ["gauss", "variance", "cov-density", "cov-filter"] {
+        let (_, out) = render(scene, m, &["--spp", "4", "--method", m]);
+        assert!(out.contains(&format!("render: {m},")), "{out}");
+    }
+    let bad = covtrace(&["render", scene, "--method", "fast\nest"]);
+    let err = String::from_utf8_lossy(&bad.stderr);
+    assert_eq!(bad.status.code(), Some(2), "{err}");
+    assert!(err.contains(r"unknown method `fast\nest`"), "{err}");
+}
+
+/// `--spp` is the average budget: the samples taken are the budget times the pixels
+/// (within rounding), for uniform and for the adaptive allocation.
+#[test]
+fn spp_is_the_average_budget() {
+    for (m, spp) in [("uniform", "3"), ("cov", "8")] {
+        let (_, out) = render(
+            "examples/scenes/pool.ron",
+            &format!("spp-{m}"),
+            &["--spp", spp, "--method", m],
+        );
+        let want = spp.parse::<u64>().unwrap() * 32 * 24;
+        let samples: u64 = out
+            .split("render: ")
+            .nth(1)
+            .and_then(|r| r.split(", ").nth(1))
+            .and_then(|r| r.split(' ').next())
+            .and_then(|n| n.parse().ok())
+            .unwrap_or_else(|| panic!("no sample count in {out}"));
+        assert!(
+            samples.abs_diff(want) <= 32 * 24,
+            "{m}: {samples} samples for {want}"
+        );
+    }
+    for bad in ["0", "65537", "-1", "x"] {
+        let out = covtrace(&["render", "examples/scenes/pool.ron", &format!("--spp={bad}")]);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "--spp {bad}");
+        assert_eq!(err.trim_end().lines().count(), 1, "{err}");
+    }
+}
+
+/// `--time` renders passes until the time is spent and says what it reached.
+#[test]
+fn time_renders_progressively_and_says_what_it_reached() {
+    let (exr, out) = render(
+        "examples/scenes/pool.ron",
+        "timed",
+        &["--spp", "1", "--time", "1"],
+    );
+    let passes: u32 = out
+        .split(" pass(es) of 1 spp in the 1 s asked")
+        .next()
+        .and_then(|p| p.rsplit(' ').next())
+        .and_then(|p| p.parse().ok())
+        .unwrap_or_else(|| panic!("no pass count in {out}"));
+    assert!(passes >= 2, "{out}");
+    assert!(out.contains("spp on average reached"), "{out}");
+    assert!(pixels(&exr).iter().all(|v| v.is_finite()));
+    for bad in ["0", "-2", "nan", "inf", "1e9", "soon"] {
+        let o = covtrace(&["render", "examples/scenes/pool.ron", &format!("--time={bad}")]);
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "--time {bad}: {err}");
+        assert_eq!(err.trim_end().lines().count(), 1, "{err}");
+    }
+}
+
+/// `render --method cov --spp 16 --seed 1` writes the image that `render-bench` measures
+/// for the same method, budget and seed: one renderer, the same bits.
+#[test]
+fn render_and_render_bench_give_the_same_bits() {
+    let scene = "examples/scenes/glossy.ron";
+    let (exr, _) = render(scene, "same", &["--method", "cov", "--spp", "16", "--seed", "1"]);
+    let dir = tmp("bench-same");
+    let out = covtrace(&[
+        "render-bench",
+        scene,
+        "--size",
+        "32x24",
+        "--ref-spp",
+        "4",
+        "--budgets",
+        "16",
+        "--methods",
+        "cov",
+        "--seed",
+        "1",
+        "-o",
+        dir.to_str().expect("utf-8 path"),
+    ]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert_eq!(pixels(&exr), pixels(&dir.join("cov.exr")));
+    // And another seed gives another image (the comparison can fail).
+    let (other, _) = render(scene, "other", &["--method", "cov", "--spp", "16", "--seed", "2"]);
+    assert_ne!(pixels(&other), pixels(&dir.join("cov.exr")));
+}

@@ -265,7 +265,7 @@ impl<const N: usize> Cov<N> {
         let mut c = Self::zeros();
         for i in 0..N {
             for j in i..N {
-                c.set(i, j, 0.5 * (m[(i, j)] + m[(j, i)]));
+                c.set(i, j, 0.5 * m[(i, j)] + 0.5 * m[(j, i)]);
             }
         }
         let report = c.validity();
@@ -344,9 +344,25 @@ impl<const N: usize> Cov<N> {
 
     /// Eigenvalues, ascending (Jacobi; robust for entries from 1e-300 to 1e300).
     pub fn eigenvalues(&self) -> [f64; N] {
-        let (vals, _) = sym_eigen(N, &self.to_small());
+        // Decomposed at unit scale (the largest entry in [1, 2)), so that entries near
+        // f64's limits do not overflow inside the iteration; eigenvalues scale with Σ. The
+        // scale is a power of two: scaling is exact, the same bits as unscaled.
+        let mut a = self.to_small();
+        let largest = a.iter().flatten().fold(0.0f64, |m, v| m.max(v.abs()));
+        let scale = if largest > 0.0 && largest.is_finite() {
+            2f64.powi(largest.log2().floor() as i32)
+        } else {
+            0.0
+        };
+        if scale > 0.0 && scale.is_finite() {
+            a.iter_mut().flatten().for_each(|v| *v /= scale);
+        }
+        let (vals, _) = sym_eigen(N, &a);
         let mut out = [0.0; N];
         out.copy_from_slice(&vals[..N]);
+        if scale > 0.0 && scale.is_finite() {
+            out.iter_mut().for_each(|v| *v *= scale);
+        }
         out
     }
 

@@ -1,0 +1,131 @@
+//! Scene errors: every check made after parsing is positioned where the parser read the
+//! value (not where its text first occurs), and every message is one line.
+
+use std::path::Path;
+
+use cov_render::World;
+
+const BASE: &str = r#"Scene(
+    camera: (position: (0.0, 1.0, 3.0), look_at: LOOK, fov: FOV, width: 8, height: 8LENS),
+    materials: { "w": Diffuse(albedo: (0.5, 0.5, 0.5)), MAT },
+    lights: LIGHTS,
+    shapes: [Sphere(center: (0.0, 0.5, 0.0), radius: 0.5, material: "w"), SHAPE],
+)"#;
+
+/// The scene text with each `(placeholder, value)` replaced (defaults for the others).
+fn scene(parts: &[(&str, &str)]) -> String {
+    let mut t = BASE.to_string();
+    for (k, v) in parts {
+        t = t.replace(k, v);
+    }
+    for (k, v) in [
+        ("LOOK", "(0.0, 1.0, 0.0)"),
+        ("FOV", "40.0"),
+        ("LENS", ""),
+        (", MAT", ""),
+        (
+            "LIGHTS",
+            "[Sphere(center: (0.0, 2.0, 0.0), radius: 0.2, radiance: (1.0, 1.0, 1.0))]",
+        ),
+        (", SHAPE", ""),
+    ] {
+        t = t.replace(k, v);
+    }
+    t
+}
+
+/// The error of `text`, as `line:col: message`.
+fn error(text: &str) -> String {
+    let e = World::from_text(text, "s.ron", Path::new("."))
+        .unwrap_err()
+        .to_string();
+    assert_eq!(e.lines().count(), 1, "{e}");
+    e.strip_prefix("s.ron:").unwrap_or(&e).to_string()
+}
+
+#[test]
+fn checks_after_parsing_point_at_the_value() {
+    let cases: [(&[(&str, &str)], &str); 9] = [
+        (
+            &[("LOOK", "(0.0, 1.0, 3.0)")],
+            "2:50: the camera looks at its own position",
+        ),
+        (&[("FOV", "180.0")], "2:72: fov must be below 180 degrees"),
+        (
+            &[("LENS", ", lens: (aperture: 0.01, focus_distance: 0.01)")],
+            "2:138: focus_distance 0.01 must exceed the focal length 0.05",
+        ),
+        (
+            &[("LENS", ", shutter: (open: 0.5, close: 0.1)")],
+            "2:127: the shutter closes (0.1) before it opens (0.5)",
+        ),
+        (
+            &[("MAT", r#""hot": Diffuse(albedo: (2.0, 0.5, 0.5))"#)],
+            "3:57: material `hot`: an albedo above 1",
+        ),
+        (&[("LIGHTS", "[]")], "4:13: the scene has no light"),
+        (
+            &[(
+                "LIGHTS",
+                "[Rect(corner: (0.0, 2.0, 0.0), edge_u: (1.0, 0.0, 0.0), edge_v: (2.0, 0.0, 0.0), radiance: (1.0, 1.0, 1.0))]",
+            )],
+            "4:52: a Rect light's edges are parallel",
+        ),
+        (
+            &[(
+                "SHAPE",
+                r#"Quad(corner: (0.0, 0.0, 0.0), edge_u: (0.0, 0.0, 0.0), edge_v: (1.0, 0.0, 0.0), material: "w")"#,
+            )],
+            "5:113: a Quad's edges are parallel",
+        ),
+        // The second shape names a material that the first one's text also contains
+        // (`"w"` inside `"white"`): the position is the second shape's own.
+        (
+            &[(
+                "SHAPE",
+                r#"Sphere(center: (0.0, 0.5, 0.0), radius: 0.5, material: "white")"#,
+            )],
+            "5:130: unknown material `white`; the scene defines: w",
+        ),
+    ];
+    for (parts, want) in cases {
+        let e = error(&scene(parts));
+        assert!(e.starts_with(want), "expected `{want}`, got `{e}`");
+    }
+}
+
+/// A value written on the line after its field, after a comment, is found where it is.
+#[test]
+fn a_value_on_its_own_line_is_found_there() {
+    let text = scene(&[(
+        "SHAPE",
+        "Sphere(center: (0.0, 0.5, 0.0), radius: 0.5, material: // which\n        \"gold\")",
+    )]);
+    assert!(
+        error(&text).starts_with("6:9: unknown material `gold`"),
+        "{}",
+        error(&text)
+    );
+}
+
+/// Names with line breaks and other control characters are echoed escaped, in one line.
+#[test]
+fn names_with_control_characters_stay_on_one_line() {
+    let text = scene(&[(
+        "SHAPE",
+        "Sphere(center: (0.0, 0.5, 0.0), radius: 0.5, material: \"go\\nld\\u{1b}[31m\")",
+    )]);
+    let e = error(&text);
+    assert!(e.contains(r"unknown material `go\nld\u{1b}[31m`"), "{e}");
+    let text = scene(&[("SHAPE", "Mesh(obj: \"no\\nwhere.obj\", material: \"w\")")]);
+    let e = error(&text);
+    assert!(
+        e.contains(r"OBJ `no\nwhere.obj`: no such file: ./no\nwhere.obj"),
+        "{e}"
+    );
+    let text = scene(&[("MAT", "\"h\\tot\": Diffuse(albedo: (2.0, 0.5, 0.5))")]);
+    assert!(error(&text).contains(r"material `h\tot`"), "{}", error(&text));
+    // An unknown field whose name the parser echoes.
+    let text = scene(&[("FOV", "40.0, \"x\\ny\": 1")]);
+    assert_eq!(error(&text).lines().count(), 1);
+}
