@@ -1,5 +1,5 @@
 //! `covtrace render-bench`: every sampling and reconstruction method
-//! ([`cov_render::bench::Method`]) at several sample budgets, against a cached
+//! ([`cov_render::Method`]) at several sample budgets, against a cached
 //! high-spp reference; image error against wall-clock time, the equal-error speed-up over
 //! plain Monte Carlo, and the timing breakdown.
 //!
@@ -614,7 +614,7 @@ fn write_strip(
             let name = dir.join(format!("{}.exr", m.name()));
             write_image(img, &name, &name.with_extension("png")).map_err(|e| e.to_string())?;
             let err = dir.join(format!("{}.error.png", m.name()));
-            cov_render::metrics::error_map(img, reference)
+            cov_render::output::error_map(img, reference)
                 .map_err(|e| e.to_string())?
                 .save(&err)
                 .map_err(|e| format!("{}: {e}", err.display()))?;

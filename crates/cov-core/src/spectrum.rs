@@ -24,7 +24,7 @@ pub enum Form {
     /// `Σ = L Lᵀ` ([`crate::CovFactor`]), updated by Potter's and the array algorithms:
     /// the same loss is `ε · √(Σ_big/Σ_small)`, and Σ is PSD by construction. The
     /// default: on the stiff suite's 10⁴-operator bounce chains it reaches 4e-13 to
-    /// 2.4e-12 where the covariance form reaches 4.1e-9 (README, "Numerical stability").
+    /// 2.4e-12 where the covariance form reaches 4.1e-9 (docs/stability.md).
     #[default]
     SquareRoot,
 }

@@ -1,7 +1,17 @@
 //! The renderer's errors: one type, each variant one line that says what was wrong and
 //! where.
 
-use crate::scene::SceneError;
+/// An error in a scene file, in one line: `file:line:col: message`.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+#[error("{file}:{}{message}", at.map(|(l, c)| format!("{l}:{c}: ")).unwrap_or_else(|| " ".into()))]
+pub struct SceneError {
+    /// The scene file.
+    pub file: String,
+    /// Line and column, when known.
+    pub at: Option<(usize, usize)>,
+    /// What is wrong.
+    pub message: String,
+}
 
 /// What can go wrong when rendering, in one line.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]

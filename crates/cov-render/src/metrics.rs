@@ -9,7 +9,7 @@ use crate::film::Image;
 /// scene).
 pub const REL_EPS: f64 = 0.01;
 
-fn same_size(img: &Image, reference: &Image) -> Result<(), RenderError> {
+pub(crate) fn same_size(img: &Image, reference: &Image) -> Result<(), RenderError> {
     if (img.width, img.height) == (reference.width, reference.height) {
         return Ok(());
     }
@@ -50,24 +50,6 @@ pub fn measure(img: &Image, reference: &Image) -> Result<Metrics, RenderError> {
         rmse: (se / n).sqrt(),
         relmse: rel / n,
     })
-}
-
-/// The per-pixel relative squared error of `img` against `reference` (mean over
-/// channels of `(I − R)² / (R² + ε)`), as a heat map: log scale from 1e-4 (dark) to 1
-/// (yellow) and above.
-///
-/// # Errors
-/// Images of different sizes.
-pub fn error_map(img: &Image, reference: &Image) -> Result<image::RgbImage, RenderError> {
-    same_size(img, reference)?;
-    Ok(image::RgbImage::from_fn(img.width, img.height, |x, y| {
-        let (a, r) = (img.get(x, y), reference.get(x, y));
-        let e = (0..3)
-            .map(|k| (a[k] - r[k]).powi(2) / (r[k] * r[k] + REL_EPS))
-            .sum::<f64>()
-            / 3.0;
-        image::Rgb(crate::output::colormap((e.max(1e-4).log10() + 4.0) / 4.0))
-    }))
 }
 
 #[cfg(test)]

@@ -133,3 +133,21 @@ pub fn write_maps(
     let text = serde_json::to_string(&data).map_err(|e| RenderError::file(json, e))?;
     std::fs::write(json, text).map_err(|e| RenderError::file(json, e))
 }
+
+/// The per-pixel relative squared error of `img` against `reference` (mean over
+/// channels of `(I − R)² / (R² + ε)`), as a heat map: log scale from 1e-4 (dark) to 1
+/// (yellow) and above.
+///
+/// # Errors
+/// Images of different sizes.
+pub fn error_map(img: &Image, reference: &Image) -> Result<image::RgbImage, RenderError> {
+    crate::metrics::same_size(img, reference)?;
+    Ok(image::RgbImage::from_fn(img.width, img.height, |x, y| {
+        let (a, r) = (img.get(x, y), reference.get(x, y));
+        let e = (0..3)
+            .map(|k| (a[k] - r[k]).powi(2) / (r[k] * r[k] + crate::metrics::REL_EPS))
+            .sum::<f64>()
+            / 3.0;
+        image::Rgb(colormap((e.max(1e-4).log10() + 4.0) / 4.0))
+    }))
+}

@@ -38,24 +38,14 @@ use std::collections::BTreeMap;
 use serde::Deserialize;
 use serde::de::{Deserializer, Error as _};
 
+pub use crate::error::SceneError;
+
 /// Largest image side (px): bounds memory (a float RGB image of 8192² is 800 MB).
 pub const MAX_RESOLUTION: u32 = 8192;
 /// Largest scene file read (bytes).
 pub const MAX_SCENE_BYTES: u64 = 16 << 20;
 /// Largest number of triangles over all meshes of a scene.
 pub const MAX_TRIANGLES: usize = 5_000_000;
-
-/// An error in a scene file, in one line: `file:line:col: message`.
-#[derive(Clone, Debug, PartialEq, thiserror::Error)]
-#[error("{file}:{}{message}", at.map(|(l, c)| format!("{l}:{c}: ")).unwrap_or_else(|| " ".into()))]
-pub struct SceneError {
-    /// The scene file.
-    pub file: String,
-    /// Line and column, when known.
-    pub at: Option<(usize, usize)>,
-    /// What is wrong.
-    pub message: String,
-}
 
 /// Defines a checked number type: `$name(f64)` deserialised and validated at once, so a
 /// bad value is reported where it is written.
@@ -399,25 +389,23 @@ impl SceneFile {
             // the value starts at the next character that is not white space.
             Err(e) if e.code.to_string().contains(LOCATE_MARK) => {
                 let (mut line, mut col) = (e.span.start.line, e.span.start.col);
-                let rest = text.lines().nth(line.checked_sub(1)?)?;
-                let mut chars = rest.chars().skip(col.saturating_sub(1)).peekable();
-                let mut lines = text.lines().skip(line);
-                loop {
-                    match chars.peek() {
-                        Some(c) if c.is_whitespace() => {
-                            chars.next();
-                            col += 1;
-                        }
-                        Some(_) => return Some((line, col)),
-                        None => {
-                            // The value is on a later line.
-                            let next = lines.next()?;
+                let start: usize = text
+                    .split_inclusive('\n')
+                    .take(line.checked_sub(1)?)
+                    .map(str::len)
+                    .sum();
+                let rest = text.get(start..)?;
+                for c in rest.chars().skip(col.saturating_sub(1)) {
+                    match c {
+                        '\n' => {
                             line += 1;
                             col = 1;
-                            chars = next.chars().skip(0).peekable();
                         }
+                        c if c.is_whitespace() => col += 1,
+                        _ => return Some((line, col)),
                     }
                 }
+                None
             }
             _ => None,
         }

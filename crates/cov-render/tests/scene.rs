@@ -129,3 +129,40 @@ fn names_with_control_characters_stay_on_one_line() {
     let text = scene(&[("FOV", "40.0, \"x\\ny\": 1")]);
     assert_eq!(error(&text).lines().count(), 1);
 }
+
+/// Mutated bundled scenes never panic: each loads, or fails with one line positioned in
+/// the file.
+#[test]
+fn mutated_scenes_give_one_positioned_line() {
+    use rand::{Rng, SeedableRng};
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/scenes");
+    let files: Vec<String> = ["cornell.ron", "pool.ron", "glossy.ron"]
+        .iter()
+        .map(|f| std::fs::read_to_string(dir.join(f)).expect("bundled scene"))
+        .collect();
+    let alphabet: Vec<char> = "\n\t \"\\(),:[]{}0123456789.-eEabcxyz\u{1b}\u{0}é"
+        .chars()
+        .collect();
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(5);
+    for case in 0..600 {
+        let mut text: Vec<char> = files[case % files.len()].chars().collect();
+        for _ in 0..rng.random_range(1..5) {
+            let p = rng.random_range(0..=text.len());
+            let c = alphabet[rng.random_range(0..alphabet.len())];
+            match rng.random_range(0..3) {
+                0 if p < text.len() => {
+                    text.remove(p);
+                }
+                1 => text.insert(p, c),
+                _ if p < text.len() => text[p] = c,
+                _ => text.push(c),
+            }
+        }
+        let text: String = text.into_iter().collect();
+        if let Err(e) = World::from_text(&text, "m.ron", &dir) {
+            let s = e.to_string();
+            assert_eq!(s.lines().count(), 1, "case {case}: {s}\n{text}");
+            assert!(e.at.is_some(), "case {case}: not positioned: {s}");
+        }
+    }
+}

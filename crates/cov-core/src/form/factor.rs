@@ -7,7 +7,7 @@
 //! small block's digits to cancellation: the error grows like `ε · Σ_big/Σ_small` per
 //! event. The factor holds `√Σ`, so the same cancellation costs `ε · √(Σ_big/Σ_small)`,
 //! and Σ = L Lᵀ is symmetric and PSD by construction. The stiff suite (`cov-stiff`)
-//! measures the difference; see the README's numerical-stability section.
+//! measures the difference; see docs/stability.md.
 //!
 //! The rules, on `L` (rows are axes, columns are independent "sources"):
 //!
