@@ -14,6 +14,7 @@ use std::path::{Path, PathBuf};
 use cov_render::adaptive::Guide;
 use cov_render::bench::{fit_loglog, speedup};
 use cov_render::covpass::STRIDES;
+use cov_render::denoise::Denoise;
 use cov_render::film::tile_count;
 use cov_render::metrics::measure;
 use cov_render::output::{read_image, tonemap, write_image};
@@ -24,6 +25,25 @@ use plotters::prelude::*;
 
 use crate::plot::{COLORS, Picture, log_tick};
 use crate::render::{bar, parse_size};
+
+/// A method and the denoiser after it, named as on the command line (`cov`, `cov+oidn`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Variant(pub Method, pub Denoise);
+
+impl Variant {
+    /// Plain Monte Carlo, the baseline of every speed-up.
+    pub const UNIFORM: Variant = Variant(Method::Uniform, Denoise::None);
+
+    /// Its name in tables and on the command line.
+    pub fn name(self) -> String {
+        self.0.with_denoiser(self.1)
+    }
+
+    /// Whether it needs the covariance pass.
+    pub fn uses_covariance(self) -> bool {
+        self.0.uses_covariance()
+    }
+}
 
 /// Largest number of budgets one bench takes.
 pub const MAX_BUDGETS: usize = 12;
@@ -71,8 +91,8 @@ pub struct BenchArgs {
 /// One row of the results.
 #[derive(Clone, Debug, serde::Serialize)]
 pub struct Row {
-    /// Method name.
-    pub method: &'static str,
+    /// Method name (with its denoiser: `cov+oidn`).
+    pub method: String,
     /// Average samples per pixel asked for.
     pub budget: f64,
     /// Samples taken.
@@ -96,10 +116,10 @@ pub struct Row {
 }
 
 impl Row {
-    fn new(r: &Rendered, reference: &cov_render::Image) -> Result<Row, String> {
+    fn new(v: Variant, r: &Rendered, reference: &cov_render::Image) -> Result<Row, String> {
         let e = measure(&r.image, reference).map_err(|e| e.to_string())?;
         Ok(Row {
-            method: r.method.name(),
+            method: v.name(),
             budget: r.budget,
             samples: r.samples,
             seconds: r.timing.total(),
@@ -123,26 +143,39 @@ fn fnv(bytes: &[u8], mut h: u64) -> u64 {
     h
 }
 
-fn methods(names: &[String]) -> Result<Vec<Method>, String> {
+fn methods(names: &[String]) -> Result<Vec<Variant>, String> {
     if names.is_empty() {
-        return Ok(Method::ALL.to_vec());
+        return Ok(Method::ALL.map(|m| Variant(m, Denoise::None)).to_vec());
     }
     let mut out = Vec::new();
     for n in names {
-        let m = crate::render::parse_method(n).map_err(|e| format!("--methods: {e}"))?;
-        if !out.contains(&m) {
-            out.push(m);
+        let (m, d) = Method::parse_with_denoiser(n.trim()).ok_or_else(|| {
+            format!(
+                "--methods: unknown method `{}` (one of: {}; each may be followed by +oidn or +oidn-color)",
+                cov_render::echo(n),
+                Method::ALL.map(Method::name).join(", ")
+            )
+        })?;
+        if d != Denoise::None && !cov_render::denoise::AVAILABLE {
+            return Err(format!(
+                "--methods: `{}` needs Open Image Denoise, and this covtrace was built without it: rebuild with `--features oidn` and OIDN_DIR set (docs/oidn.md)",
+                cov_render::echo(n)
+            ));
+        }
+        let v = Variant(m, d);
+        if !out.contains(&v) {
+            out.push(v);
         }
     }
-    if out.iter().any(|m| *m != Method::Uniform) && !out.contains(&Method::Uniform) {
+    if out.iter().any(|m| *m != Variant::UNIFORM) && !out.contains(&Variant::UNIFORM) {
         // Speed-ups are measured against uniform Monte Carlo: always run it.
-        out.insert(0, Method::Uniform);
+        out.insert(0, Variant::UNIFORM);
     }
     Ok(out)
 }
 
 /// Checks the arguments before any work.
-fn check_args(a: &BenchArgs) -> Result<(Vec<Method>, Vec<f64>), String> {
+fn check_args(a: &BenchArgs) -> Result<(Vec<Variant>, Vec<f64>), String> {
     if a.budgets.is_empty() || a.budgets.len() > MAX_BUDGETS {
         return Err(format!(
             "--budgets: give 1 to {MAX_BUDGETS} values, got {}",
@@ -245,17 +278,18 @@ pub fn bench(a: &BenchArgs) -> Result<String, String> {
         .save(a.output.join("reference.png"))
         .map_err(|e| format!("{}: {e}", a.output.join("reference.png").display()))?;
 
-    let settings = |method: Method, spp: f64, seed: u64| RenderSettings {
+    let settings = |Variant(method, denoise): Variant, spp: f64, seed: u64| RenderSettings {
         method,
         spp,
         seed,
+        denoise,
         cov_paths: a.cov_paths,
         cov_stride: a.cov_stride,
         ..RenderSettings::default()
     };
     // Every run goes through the library's renderer, with the covariance guide traced
     // here once (its time is added to every covariance run).
-    let run = |m: Method, budget: f64, guide: Option<&Guide>, seed: u64| -> Result<Rendered, String> {
+    let run = |m: Variant, budget: f64, guide: Option<&Guide>, seed: u64| -> Result<Rendered, String> {
         let mut r = Renderer::new(&world, settings(m, budget, seed)).map_err(|e| e.to_string())?;
         if let Some(g) = guide {
             r = r.with_guide(g.clone()).map_err(|e| e.to_string())?;
@@ -263,15 +297,15 @@ pub fn bench(a: &BenchArgs) -> Result<String, String> {
         r.render(None).map_err(|e| e.to_string())
     };
     // Warm-up (caches, the thread pool): one uniform pass at 1 spp, not recorded.
-    run(Method::Uniform, 1.0, None, a.seed ^ 0x77)?;
+    run(Variant::UNIFORM, 1.0, None, a.seed ^ 0x77)?;
     // The covariance pass, once per repeat (its fastest time is added to every covariance
     // run: the pass does not depend on the budget).
     let guide = if methods.iter().any(|m| m.uses_covariance()) {
         let mut best: Option<Guide> = None;
         for _ in 0..a.repeat {
             let b = bar(tile_count(&world), "covariance");
-            let mut r =
-                Renderer::new(&world, settings(Method::Cov, 1.0, a.seed)).map_err(|e| e.to_string())?;
+            let mut r = Renderer::new(&world, settings(Variant(Method::Cov, Denoise::None), 1.0, a.seed))
+                .map_err(|e| e.to_string())?;
             let traced = r.trace_covariance(Some(&|| b.inc(1))).map(|_| ());
             b.finish_and_clear();
             traced.map_err(|e| e.to_string())?;
@@ -303,16 +337,16 @@ pub fn bench(a: &BenchArgs) -> Result<String, String> {
     );
     b.set_message("render-bench");
     let mut rows: Vec<Row> = Vec::new();
-    let mut images: Vec<(Method, f64, f64, cov_render::Image)> = Vec::new();
+    let mut images: Vec<(Variant, f64, f64, cov_render::Image)> = Vec::new();
     for &budget in &budgets {
         for &m in &methods {
             // Repeats use other seeds: the errors are averaged (a low-spp image's error
             // depends on where its rare bright paths fell), the fastest time is kept.
             let first = run(m, budget, guide.as_ref(), a.seed)?;
-            let mut row = Row::new(&first, &reference)?;
+            let mut row = Row::new(m, &first, &reference)?;
             for k in 1..a.repeat {
                 let seed = a.seed.wrapping_add(u64::from(k) * 1_000_003);
-                let again = Row::new(&run(m, budget, guide.as_ref(), seed)?, &reference)?;
+                let again = Row::new(m, &run(m, budget, guide.as_ref(), seed)?, &reference)?;
                 row.rmse += again.rmse;
                 row.relmse += again.relmse;
                 if again.seconds < row.seconds {
@@ -380,18 +414,18 @@ pub fn bench(a: &BenchArgs) -> Result<String, String> {
 
 /// The table printed at the end: relMSE per method and budget, the median equal-error
 /// speed-up, and the covariance share of time.
-fn summary(rows: &[Row], methods: &[Method], budgets: &[f64]) -> String {
+fn summary(rows: &[Row], methods: &[Variant], budgets: &[f64]) -> String {
     let mut s = String::from(
         "\nrelMSE (seconds) per budget; equal-error speed-up over uniform (median over budgets)\n",
     );
-    let _ = write!(s, "{:<12}", "method");
+    let _ = write!(s, "{:<18}", "method");
     for b in budgets {
         let _ = write!(s, "{:>20}", format!("{b} spp"));
     }
     let _ = writeln!(s, "{:>10}{:>12}", "speed-up", "cov share");
     for m in methods {
         let mine: Vec<&Row> = rows.iter().filter(|r| r.method == m.name()).collect();
-        let _ = write!(s, "{:<12}", m.name());
+        let _ = write!(s, "{:<18}", m.name());
         for r in &mine {
             let _ = write!(s, "{:>20}", format!("{:.3e} ({:.2})", r.relmse, r.seconds));
         }
@@ -419,9 +453,9 @@ fn summary(rows: &[Row], methods: &[Method], budgets: &[f64]) -> String {
             let _ = match (t, base) {
                 (Some((t, exact)), Some((b, _))) => {
                     let ge = if *exact { "" } else { "≥ " };
-                    writeln!(s, "{m:<12}{t:>10.3} s{:>12}", format!("{ge}{:.2}×", b / t))
+                    writeln!(s, "{m:<18}{t:>10.3} s{:>12}", format!("{ge}{:.2}×", b / t))
                 }
-                _ => writeln!(s, "{m:<12}{:>12}", "not reached"),
+                _ => writeln!(s, "{m:<18}{:>12}", "not reached"),
             };
         }
         let _ = writeln!(s, "(≥: the method's smallest budget is already below that error)");
@@ -431,7 +465,7 @@ fn summary(rows: &[Row], methods: &[Method], budgets: &[f64]) -> String {
 
 /// The error uniform Monte Carlo reaches at its largest budget, and the time each method
 /// needs to reach it ([`cov_render::bench::time_to_reach`]).
-fn at_error(rows: &[Row], methods: &[Method]) -> AtError {
+fn at_error(rows: &[Row], methods: &[Variant]) -> AtError {
     let target = rows
         .iter()
         .filter(|r| r.method == "uniform")
@@ -453,7 +487,7 @@ fn at_error(rows: &[Row], methods: &[Method]) -> AtError {
 
 /// What [`at_error`] gives: the target error and each method's time to reach it (and
 /// whether interpolated).
-type AtError = Option<(f64, Vec<(&'static str, Option<(f64, bool)>)>)>;
+type AtError = Option<(f64, Vec<(String, Option<(f64, bool)>)>)>;
 
 fn write_results(dir: &Path, rows: &[Row], uniform: &[(f64, f64)], at: AtError) -> Result<(), String> {
     let mut csv = String::from(
@@ -511,7 +545,7 @@ fn sparse_log_tick(v: &f64) -> String {
 /// The log–log chart of relMSE against seconds, a line per method.
 struct ErrorChart<'a> {
     rows: &'a [Row],
-    methods: &'a [Method],
+    methods: &'a [Variant],
     title: &'a str,
 }
 
@@ -582,13 +616,13 @@ impl Picture for ErrorChart<'_> {
 /// Returns the target time and what was picked.
 fn write_strip(
     path: &Path,
-    images: &[(Method, f64, f64, cov_render::Image)],
+    images: &[(Variant, f64, f64, cov_render::Image)],
     reference: &cov_render::Image,
 ) -> Result<(f64, String), String> {
-    let uni: Vec<&(Method, f64, f64, cov_render::Image)> =
-        images.iter().filter(|i| i.0 == Method::Uniform).collect();
+    let uni: Vec<&(Variant, f64, f64, cov_render::Image)> =
+        images.iter().filter(|i| i.0 == Variant::UNIFORM).collect();
     let target = uni.get(uni.len() / 2).map_or(1.0, |u| u.2).max(1e-9);
-    let mut methods: Vec<Method> = Vec::new();
+    let mut methods: Vec<Variant> = Vec::new();
     for i in images {
         if !methods.contains(&i.0) {
             methods.push(i.0);

@@ -5,6 +5,7 @@
 use std::path::{Path, PathBuf};
 
 use cov_render::covpass::{MAX_COV_PATHS, STRIDES};
+use cov_render::denoise::Denoise;
 use cov_render::film::tile_count;
 use cov_render::output::{write_image, write_maps};
 use cov_render::renderer::{MAX_TIME, timed};
@@ -28,6 +29,11 @@ pub struct RenderArgs {
     /// this many seconds are spent (covariance pass included).
     #[arg(long)]
     pub time: Option<f64>,
+    /// Denoise the image with Intel Open Image Denoise: oidn (guided by the first hit's
+    /// albedo and normal) or oidn-color (the colour alone). Needs a build with
+    /// `--features oidn` (docs/oidn.md).
+    #[arg(long, value_parser = parse_denoise, default_value = "none")]
+    pub denoise: Denoise,
     /// Output EXR (linear); a PNG and the covariance maps are written beside it.
     #[arg(short, long, default_value = "render.exr")]
     pub output: PathBuf,
@@ -43,6 +49,31 @@ pub struct RenderArgs {
     /// Render at this size instead of the scene's (`WIDTHxHEIGHT`, e.g. `640x480`).
     #[arg(long, value_parser = parse_size)]
     pub size: Option<(u32, u32)>,
+}
+
+/// Parses a denoiser name: `none`, `oidn` or `oidn-color`.
+///
+/// # Errors
+/// An unknown name, or a denoiser this build does not have.
+pub fn parse_denoise(s: &str) -> Result<Denoise, String> {
+    let d = match s.trim() {
+        "none" => Denoise::None,
+        t => Denoise::from_name(t)
+            .filter(|d| *d != Denoise::None)
+            .ok_or_else(|| {
+                format!(
+                    "unknown denoiser `{}` (one of: none, oidn, oidn-color)",
+                    cov_render::echo(s)
+                )
+            })?,
+    };
+    if d != Denoise::None && !cov_render::denoise::AVAILABLE {
+        return Err(
+            "this covtrace was built without Open Image Denoise: rebuild with `--features oidn` and OIDN_DIR set (docs/oidn.md)"
+                .into(),
+        );
+    }
+    Ok(d)
 }
 
 /// Parses a method name ([`Method::from_name`]).
@@ -95,6 +126,7 @@ pub fn settings(a: &RenderArgs) -> Result<RenderSettings, String> {
         cov_paths: a.cov_paths,
         cov_stride: a.cov_stride,
         max_luminance: f64::INFINITY,
+        denoise: a.denoise,
     })
 }
 
@@ -122,8 +154,8 @@ pub fn parse_size(s: &str) -> Result<(u32, u32), String> {
 }
 
 /// The files a render writes, from the EXR's path `out.exr`: `out.png`, `out.density.png`,
-/// `out.filter.png`, `out.cov.json`.
-pub fn outputs(exr: &Path) -> [PathBuf; 4] {
+/// `out.filter.png`, `out.cov.json`, and the feature images `out.aov.exr`.
+pub fn outputs(exr: &Path) -> [PathBuf; 5] {
     let stem = exr.with_extension("");
     let s = stem.display().to_string();
     [
@@ -131,6 +163,7 @@ pub fn outputs(exr: &Path) -> [PathBuf; 4] {
         PathBuf::from(format!("{s}.density.png")),
         PathBuf::from(format!("{s}.filter.png")),
         PathBuf::from(format!("{s}.cov.json")),
+        PathBuf::from(format!("{s}.aov.exr")),
     ]
 }
 
@@ -204,7 +237,7 @@ pub fn run(a: &RenderArgs) -> Result<String, String> {
     check_output(&a.output, "exr")?;
     let world = load(&a.scene, a.size)?;
     let (w, h) = (world.camera.width, world.camera.height);
-    let [png, density, filter, json] = outputs(&a.output);
+    let [png, density, filter, json, aov] = outputs(&a.output);
     let mut out = format!(
         "scene: {} ({w}×{h} px, {} primitives, {} lights)\n",
         cov_render::echo(&a.scene.display().to_string()),
@@ -224,6 +257,7 @@ pub fn run(a: &RenderArgs) -> Result<String, String> {
     b.finish_and_clear();
     let r = r?;
     write_image(&r.image, &a.output, &png).map_err(|e| e.to_string())?;
+    cov_render::output::write_aovs(&r.film.aovs(), &aov).map_err(|e| e.to_string())?;
     let total = r.timing.total();
     if let Some(maps) = renderer.maps() {
         let sp = covtrace::sensor::SensorParams::default();
@@ -250,14 +284,19 @@ pub fn run(a: &RenderArgs) -> Result<String, String> {
         ),
     };
     out.push_str(&format!(
-        "render: {}, {} samples ({:.1} spp on average) in {total:.2} s (sampling {:.2} s, reconstruction {:.2} s){reached}\n",
-        r.method.name(),
+        "render: {}, {} samples ({:.1} spp on average) in {total:.2} s (sampling {:.2} s, reconstruction {:.2} s{}){reached}\n",
+        r.method.with_denoiser(a.denoise),
         r.samples,
         r.samples as f64 / n,
         r.timing.sampling,
         r.timing.reconstruction,
+        if a.denoise == Denoise::None {
+            String::new()
+        } else {
+            format!(", denoising {:.2} s", r.timing.denoising)
+        },
     ));
-    let mut written = vec![a.output.clone(), png];
+    let mut written = vec![a.output.clone(), png, aov];
     if renderer.maps().is_some() {
         written.extend([density, filter, json]);
     }

@@ -267,3 +267,46 @@ fn render_and_render_bench_give_the_same_bits() {
     let (other, _) = render(scene, "other", &["--method", "cov", "--spp", "16", "--seed", "2"]);
     assert_ne!(pixels(&other), pixels(&dir.join("cov.exr")));
 }
+
+/// Without Open Image Denoise in the build, `--denoise` and the `+oidn` methods say how
+/// to get it, in one line, before any work.
+#[cfg(not(feature = "oidn"))]
+#[test]
+fn denoise_without_oidn_says_how_to_get_it() {
+    for args in [
+        vec!["render", "examples/scenes/pool.ron", "--denoise", "oidn"],
+        vec![
+            "render-bench",
+            "examples/scenes/pool.ron",
+            "--methods",
+            "cov+oidn",
+        ],
+    ] {
+        let out = covtrace(&args);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{err}");
+        assert_eq!(err.trim_end().lines().count(), 1, "{err}");
+        assert!(err.contains("--features oidn"), "{err}");
+    }
+    let out = covtrace(&["render", "examples/scenes/pool.ron", "--denoise", "magic"]);
+    assert!(String::from_utf8_lossy(&out.stderr).contains("unknown denoiser `magic`"));
+}
+
+/// With Open Image Denoise: `--denoise oidn` writes a denoised image and says how long
+/// the denoiser took.
+#[cfg(feature = "oidn")]
+#[test]
+fn denoise_with_oidn_writes_a_denoised_image() {
+    let (exr, out) = render(
+        "examples/scenes/cornell.ron",
+        "denoised",
+        &["--spp", "2", "--denoise", "oidn"],
+    );
+    assert!(
+        out.contains("render: cov+oidn,") && out.contains("denoising"),
+        "{out}"
+    );
+    let (noisy, _) = render("examples/scenes/cornell.ron", "noisy", &["--spp", "2"]);
+    assert_ne!(pixels(&exr), pixels(&noisy));
+    assert!(pixels(&exr).iter().all(|v| v.is_finite() && *v >= 0.0));
+}

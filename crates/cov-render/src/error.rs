@@ -56,6 +56,9 @@ pub enum RenderError {
         /// Second height.
         b_h: u32,
     },
+    /// The denoiser is not in this build, or failed.
+    #[error("{0}")]
+    Denoiser(String),
     /// A file could not be read or written.
     #[error("{path}: {message}")]
     File {

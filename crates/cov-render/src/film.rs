@@ -252,11 +252,30 @@ pub struct Film {
     pub reflected: Vec<DVec3>,
     /// Sum of the samples' luminance, and of its square.
     pub lum: Vec<[f64; 2]>,
+    /// Sum of the samples' first-hit albedo ([`crate::trace::Features`]).
+    pub albedo: Vec<DVec3>,
+    /// Sum of the samples' first-hit shading normal.
+    pub normal: Vec<DVec3>,
+    /// Sum of the samples' first-hit distance (m).
+    pub depth: Vec<f64>,
+}
+
+/// A film's feature images (AOVs): per pixel, the mean over its samples of the first
+/// hit's albedo, shading normal and distance ([`crate::trace::Features`]).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Aovs {
+    /// Albedo, in [0, 1].
+    pub albedo: Image,
+    /// Shading normal: the mean of unit vectors (shorter where a pixel sees several
+    /// surfaces), each component in [-1, 1].
+    pub normal: Image,
+    /// Distance (m), row by row.
+    pub depth: Vec<f64>,
 }
 
 /// What one tile hands to the film, per pixel row by row: the sums of emitted and
-/// reflected radiance, the count, the luminance sums.
-type TileOut = Vec<(DVec3, DVec3, u32, [f64; 2])>;
+/// reflected radiance, the count, the luminance sums, the sums of the features.
+type TileOut = Vec<(DVec3, DVec3, u32, [f64; 2], (DVec3, DVec3, f64))>;
 
 /// Rows of pixels one reconstruction band splats (bands run in parallel).
 const BAND: usize = 16;
@@ -272,6 +291,34 @@ impl Film {
             emitted: vec![DVec3::ZERO; n],
             reflected: vec![DVec3::ZERO; n],
             lum: vec![[0.0; 2]; n],
+            albedo: vec![DVec3::ZERO; n],
+            normal: vec![DVec3::ZERO; n],
+            depth: vec![0.0; n],
+        }
+    }
+
+    /// The feature images: each pixel's means (0 where it has no sample).
+    pub fn aovs(&self) -> Aovs {
+        let mean = |v: &[DVec3]| -> Vec<DVec3> {
+            v.iter()
+                .zip(&self.count)
+                .map(|(s, &n)| if n == 0 { DVec3::ZERO } else { *s / f64::from(n) })
+                .collect()
+        };
+        let image = |pixels| Image {
+            width: self.width,
+            height: self.height,
+            pixels,
+        };
+        Aovs {
+            albedo: image(mean(&self.albedo)),
+            normal: image(mean(&self.normal)),
+            depth: self
+                .depth
+                .iter()
+                .zip(&self.count)
+                .map(|(s, &n)| if n == 0 { 0.0 } else { s / f64::from(n) })
+                .collect(),
         }
     }
 
@@ -392,7 +439,10 @@ impl Film {
                 .collect();
             for (&(x0, y0, x1, y1), out) in batch.iter().zip(outs) {
                 let coords = (y0..y1).flat_map(|y| (x0..x1).map(move |x| (y * w + x) as usize));
-                for (i, (e, r, n, l)) in coords.zip(out) {
+                for (i, (e, r, n, l, aov)) in coords.zip(out) {
+                    self.albedo[i] += aov.0;
+                    self.normal[i] += aov.1;
+                    self.depth[i] += aov.2;
                     self.emitted[i] += e;
                     self.reflected[i] += r;
                     self.count[i] += n;
@@ -421,12 +471,20 @@ impl Film {
                 let n = counts.get(i).copied().unwrap_or(0).min(MAX_INDEX - first);
                 let mut sampler = SobolSampler::new(seed, w, x, y);
                 let (mut se, mut sr, mut l1, mut l2) = (DVec3::ZERO, DVec3::ZERO, 0.0, 0.0);
+                let mut aov = (DVec3::ZERO, DVec3::ZERO, 0.0);
                 for s in first..first + n {
                     sampler.start(s);
                     let s = &mut sampler;
                     let (jx, jy, lu, lv, ut) = (s.next(), s.next(), s.next(), s.next(), s.next());
                     let ray = world.camera.ray(x as f64 + jx, y as f64 + jy, (lu, lv), ut);
-                    let (e, r) = radiance_parts(world, &ray, s);
+                    let rs = radiance_parts(world, &ray, s);
+                    let f = rs.features;
+                    if (f.albedo + f.normal).is_finite() && f.depth.is_finite() {
+                        aov.0 += f.albedo;
+                        aov.1 += f.normal;
+                        aov.2 += f.depth;
+                    }
+                    let (e, r) = (rs.emitted, rs.reflected);
                     let (e, r) = if (e + r).is_finite() {
                         (e, r)
                     } else {
@@ -445,7 +503,7 @@ impl Film {
                     l1 += yl;
                     l2 += yl * yl;
                 }
-                out.push((se, sr, n, [l1, l2]));
+                out.push((se, sr, n, [l1, l2], aov));
             }
         }
         out

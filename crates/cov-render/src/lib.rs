@@ -33,6 +33,7 @@
 //! | [`covpass`] | the covariance pass: operator chains per path, the per-pixel maps |
 //! | [`adaptive`] | sample allocation and per-pixel filters from the maps |
 //! | [`renderer`] | one renderer for every method: [`Renderer`], [`RenderSettings`] |
+//! | [`denoise`] | Intel Open Image Denoise after reconstruction (feature `oidn`) |
 //! | [`metrics`], [`bench`] | image error against a reference; error against time |
 //! | [`output`], [`validate`] | files written; the maps checked against reference images |
 //!
@@ -43,6 +44,7 @@
 pub mod adaptive;
 pub mod bench;
 pub mod covpass;
+pub mod denoise;
 mod error;
 pub mod film;
 pub mod geometry;

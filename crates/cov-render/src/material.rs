@@ -60,6 +60,15 @@ fn smith_g1(cos: f64, a2: f64) -> f64 {
 }
 
 impl Material {
+    /// The reflectance (the albedo a denoiser is given).
+    pub fn albedo(&self) -> DVec3 {
+        match *self {
+            Material::Diffuse { albedo } | Material::Phong { albedo, .. } | Material::Ggx { albedo, .. } => {
+                albedo
+            }
+        }
+    }
+
     /// The lobe the covariance pass traces for this material.
     pub fn lobe(&self) -> Lobe {
         match *self {

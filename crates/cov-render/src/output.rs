@@ -8,7 +8,7 @@ use glam::DVec3;
 use crate::RenderError;
 use crate::adaptive::{content, filter_std};
 use crate::covpass::CovMaps;
-use crate::film::Image;
+use crate::film::{Aovs, Image};
 
 /// sRGB encoding of a linear value in `[0, 1]`.
 fn srgb(c: f64) -> u8 {
@@ -150,4 +150,39 @@ pub fn error_map(img: &Image, reference: &Image) -> Result<image::RgbImage, Rend
             / 3.0;
         image::Rgb(colormap((e.max(1e-4).log10() + 4.0) / 4.0))
     }))
+}
+
+/// Writes a film's feature images as one multi-layer OpenEXR file (32-bit float): layer
+/// `albedo` (R, G, B), layer `normal` (R, G, B: the components x, y, z in [-1, 1], world
+/// space) and layer `depth` (Z, m), the guides a denoiser takes.
+///
+/// # Errors
+/// The file cannot be written.
+pub fn write_aovs(aovs: &Aovs, path: &Path) -> Result<(), RenderError> {
+    use exr::prelude::*;
+    let (w, h) = (aovs.albedo.width as usize, aovs.albedo.height as usize);
+    fn at(img: &crate::film::Image, p: exr::math::Vec2<usize>) -> (f32, f32, f32) {
+        let v = img.pixels[p.y() * img.width as usize + p.x()];
+        (v.x as f32, v.y as f32, v.z as f32)
+    }
+    let layer = |name: &str| (LayerAttributes::named(name), Encoding::FAST_LOSSLESS);
+    let (na, ea) = layer("albedo");
+    let albedo = Layer::new((w, h), na, ea, SpecificChannels::rgb(|p| at(&aovs.albedo, p)));
+    let (nn, en) = layer("normal");
+    let normal = Layer::new((w, h), nn, en, SpecificChannels::rgb(|p| at(&aovs.normal, p)));
+    let depth = Layer::new(
+        (w, h),
+        LayerAttributes::named("depth"),
+        Encoding::FAST_LOSSLESS,
+        SpecificChannels::build()
+            .with_channel("Z")
+            .with_pixel_fn(|p: Vec2<usize>| (aovs.depth[p.y() * w + p.x()] as f32,)),
+    );
+    Image::empty(ImageAttributes::new(IntegerBounds::from_dimensions((w, h))))
+        .with_layer(albedo)
+        .with_layer(normal)
+        .with_layer(depth)
+        .write()
+        .to_file(path)
+        .map_err(|e| RenderError::file(path, e))
 }

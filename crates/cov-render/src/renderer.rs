@@ -39,6 +39,7 @@ use std::time::Instant;
 use crate::RenderError;
 use crate::adaptive::{Guide, MAX_RATIO, adapted_filters, allocate, relative_variance};
 use crate::covpass::{CovMaps, MAX_COV_PATHS, STRIDES, covariance_maps};
+use crate::denoise::Denoise;
 use crate::film::{Film, Filter, Gaussian, Image, MAX_SPP, Progress};
 use crate::world::World;
 
@@ -92,6 +93,26 @@ impl Method {
         Method::ALL.into_iter().find(|m| m.name() == s)
     }
 
+    /// The name of this method followed by a denoiser, as render-bench writes it:
+    /// `cov`, `cov+oidn`, `uniform+oidn-color`.
+    pub fn with_denoiser(self, d: Denoise) -> String {
+        match d {
+            Denoise::None => self.name().to_string(),
+            d => format!("{}+{}", self.name(), d.name()),
+        }
+    }
+
+    /// The method and denoiser of a name written as [`Method::with_denoiser`] writes it.
+    pub fn parse_with_denoiser(s: &str) -> Option<(Method, Denoise)> {
+        match s.split_once('+') {
+            None => Some((Method::from_name(s)?, Denoise::None)),
+            Some((m, d)) => Some((
+                Method::from_name(m)?,
+                Denoise::from_name(d).filter(|d| *d != Denoise::None)?,
+            )),
+        }
+    }
+
     /// Whether it needs the covariance pass.
     pub fn uses_covariance(self) -> bool {
         matches!(self, Method::CovDensity | Method::CovFilter | Method::Cov)
@@ -118,6 +139,8 @@ pub struct RenderSettings {
     /// unbiased image. A finite clamp is biased: for measuring the spectrum of a reference
     /// without its rare caustic fireflies (`render-check`), never for an image.
     pub max_luminance: f64,
+    /// A denoiser run on the reconstructed image ([`crate::denoise`]).
+    pub denoise: Denoise,
 }
 
 impl Default for RenderSettings {
@@ -132,6 +155,7 @@ impl Default for RenderSettings {
             cov_paths: 1,
             cov_stride: 4,
             max_luminance: f64::INFINITY,
+            denoise: Denoise::None,
         }
     }
 }
@@ -397,6 +421,15 @@ impl<'w> Renderer<'w> {
             film.image(&filter)
         });
         timing.reconstruction += secs;
+        let image = match s.denoise {
+            Denoise::None => image,
+            d => {
+                let guides = (d == Denoise::Oidn).then(|| film.aovs());
+                let (out, secs) = timed(|| crate::denoise::oidn(&image, guides.as_ref()));
+                timing.denoising += secs;
+                out?
+            }
+        };
         Ok(Rendered {
             method,
             budget: s.spp,
@@ -445,12 +478,14 @@ pub struct Timing {
     pub reconstruction: f64,
     /// Allocating samples to pixels (the variance method's analysis of its pilot pass).
     pub allocation: f64,
+    /// The denoiser, when one runs.
+    pub denoising: f64,
 }
 
 impl Timing {
     /// The run's total.
     pub fn total(&self) -> f64 {
-        self.covariance + self.sampling + self.reconstruction + self.allocation
+        self.covariance + self.sampling + self.reconstruction + self.allocation + self.denoising
     }
 
     fn sample(&mut self, f: impl FnOnce()) {

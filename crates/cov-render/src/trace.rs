@@ -74,25 +74,67 @@ fn direct<S: Sampler + ?Sized>(
 
 /// The radiance arriving along a camera ray (one sample of the estimator).
 pub fn radiance<S: Sampler + ?Sized>(world: &World, ray: &CameraRay, rng: &mut S) -> DVec3 {
-    let (e, r) = radiance_parts(world, ray, rng);
-    e + r
+    let s = radiance_parts(world, ray, rng);
+    s.emitted + s.reflected
 }
 
-/// [`radiance`] in two parts: the emission of a light the ray sees directly, and the
-/// light reflected by the surface it sees. A film reconstructs only the second with a
-/// filter: an emitter's own edge is as sharp as the pixel grid, and its radiance is far
-/// above what it borders.
-pub fn radiance_parts<S: Sampler + ?Sized>(world: &World, ray: &CameraRay, rng: &mut S) -> (DVec3, DVec3) {
+/// What one camera ray gives the film: its radiance in two parts, and what it hit first.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct RaySample {
+    /// The emission of a light the ray sees directly.
+    pub emitted: DVec3,
+    /// The light reflected towards the camera by the surface the ray sees.
+    pub reflected: DVec3,
+    /// What the ray hits first ([`Features`]).
+    pub features: Features,
+}
+
+/// A camera ray's first hit, as a denoiser's guides use it (averaged over a pixel's
+/// samples like the image, so defocus and motion blur them the same way). The tracer has
+/// no perfectly specular material, so the first hit is the first non-specular one.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Features {
+    /// The material's reflectance; a light's colour scaled to a largest channel of 1;
+    /// 0 where the ray escapes.
+    pub albedo: DVec3,
+    /// The shading normal (world space, unit, towards the camera); 0 where the ray
+    /// escapes.
+    pub normal: DVec3,
+    /// Distance along the ray (m); 0 where the ray escapes.
+    pub depth: f64,
+}
+
+/// [`radiance`] in two parts, with the first hit's features: the emission of a light the
+/// ray sees directly, and the light reflected by the surface it sees. A film reconstructs
+/// only the second with a filter: an emitter's own edge is as sharp as the pixel grid, and
+/// its radiance is far above what it borders.
+pub fn radiance_parts<S: Sampler + ?Sized>(world: &World, ray: &CameraRay, rng: &mut S) -> RaySample {
     let Some(hit) = world
         .geometry
         .intersect(ray.origin, ray.dir, ray.time, 0.0, f64::INFINITY)
     else {
-        return (DVec3::ZERO, DVec3::ZERO);
+        return RaySample::default();
     };
-    if hit.light.is_some() {
-        return (emitted(world, &hit), DVec3::ZERO);
+    let mut features = Features {
+        albedo: DVec3::ZERO,
+        normal: hit.n,
+        depth: hit.t,
+    };
+    if let Some(l) = hit.light {
+        let le = world.lights[l as usize].radiance();
+        features.albedo = le / le.max_element().max(1e-300);
+        return RaySample {
+            emitted: emitted(world, &hit),
+            features,
+            ..RaySample::default()
+        };
     }
-    (DVec3::ZERO, reflected(world, ray, &hit, rng))
+    features.albedo = world.materials[hit.material as usize].albedo();
+    RaySample {
+        reflected: reflected(world, ray, &hit, rng),
+        features,
+        ..RaySample::default()
+    }
 }
 
 /// The light the surface at `hit` reflects towards the camera.

@@ -455,11 +455,7 @@ fn materials(desc: &SceneFile) -> Result<(Vec<Material>, Vec<String>), Failure> 
                 alpha: alpha.0,
             },
         };
-        let albedo = match mat {
-            Material::Diffuse { albedo } | Material::Phong { albedo, .. } | Material::Ggx { albedo, .. } => {
-                albedo
-            }
-        };
+        let albedo = mat.albedo();
         if albedo.max_element() > 1.0 {
             return Err((
                 name.ordinal,

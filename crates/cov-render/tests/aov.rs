@@ -1,0 +1,124 @@
+//! The feature images (AOVs) a denoiser takes, and the denoiser itself when this build
+//! has it.
+
+use std::path::Path;
+
+use cov_render::denoise::{self, Denoise};
+use cov_render::film::Film;
+use cov_render::{Method, RenderSettings, Renderer, World};
+
+mod common;
+
+/// A diffuse plane (albedo 0.5) seen straight down from 1 m: every sample's first hit has
+/// albedo 0.5, normal +y and a distance of 1 m over the cosine of its angle off the axis
+/// (within 0.25° here).
+#[test]
+fn features_of_a_plane_seen_from_above_are_its_closed_form() {
+    let world = common::plane_under_sphere_light(0.5, 2, 2);
+    let mut film = Film::new(2, 2);
+    film.render(&world, &[16; 4], 1, f64::INFINITY, None);
+    let aovs = film.aovs();
+    for i in 0..4 {
+        assert!(
+            (aovs.albedo.pixels[i] - glam::DVec3::splat(0.5))
+                .abs()
+                .max_element()
+                < 1e-12
+        );
+        assert!((aovs.normal.pixels[i] - glam::DVec3::Y).abs().max_element() < 1e-12);
+        let d = aovs.depth[i];
+        assert!((1.0..1.0 + 1e-4).contains(&d), "depth {d}");
+    }
+}
+
+/// The multi-layer EXR holds the three layers with the film's values.
+#[test]
+fn the_feature_file_reads_back() {
+    let world = common::plane_under_sphere_light(30.0, 4, 3);
+    let mut film = Film::new(4, 3);
+    film.render(&world, &[4; 12], 1, f64::INFINITY, None);
+    let aovs = film.aovs();
+    let path = std::env::temp_dir().join(format!("covtrace-aov-{}.exr", std::process::id()));
+    cov_render::output::write_aovs(&aovs, &path).unwrap();
+    let img = exr::prelude::read_all_flat_layers_from_file(&path).unwrap();
+    let _ = std::fs::remove_file(&path);
+    let names: Vec<String> = img
+        .layer_data
+        .iter()
+        .map(|l| {
+            l.attributes
+                .layer_name
+                .as_ref()
+                .map(|n| n.to_string())
+                .unwrap_or_default()
+        })
+        .collect();
+    assert_eq!(names, ["albedo", "normal", "depth"]);
+    let depth = &img.layer_data[2].channel_data.list[0].sample_data;
+    for i in 0..12 {
+        let v = depth.value_by_flat_index(i).to_f32();
+        assert!(
+            (f64::from(v) - aovs.depth[i]).abs() < 1e-6,
+            "{v} vs {}",
+            aovs.depth[i]
+        );
+    }
+}
+
+fn cornell(w: u32, h: u32) -> World {
+    World::load(&Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/scenes/cornell.ron"))
+        .unwrap()
+        .with_resolution(w, h)
+}
+
+/// Without the feature, asking for the denoiser is a clear error, never a crash.
+#[cfg(not(feature = "oidn"))]
+#[test]
+fn without_oidn_the_denoiser_says_how_to_get_it() {
+    let world = cornell(16, 12);
+    let s = RenderSettings {
+        method: Method::Uniform,
+        spp: 2.0,
+        denoise: Denoise::Oidn,
+        ..RenderSettings::default()
+    };
+    let e = Renderer::new(&world, s)
+        .unwrap()
+        .render(None)
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("--features oidn") && !e.contains('\n'), "{e}");
+    assert!(!denoise::AVAILABLE);
+}
+
+/// With OIDN: a 4-spp uniform render denoised, with and without guides, is much closer
+/// to a 256-spp reference than the noisy image.
+#[cfg(feature = "oidn")]
+#[test]
+fn oidn_lowers_the_error_of_a_noisy_render() {
+    use cov_render::metrics::measure;
+    assert!(denoise::AVAILABLE);
+    let world = cornell(64, 48);
+    let reference = cov_render::render(&world, 256, 77);
+    let run = |d: Denoise| {
+        let s = RenderSettings {
+            method: Method::Uniform,
+            spp: 4.0,
+            denoise: d,
+            ..RenderSettings::default()
+        };
+        let r = Renderer::new(&world, s).unwrap().render(None).unwrap();
+        assert!(
+            r.image
+                .pixels
+                .iter()
+                .all(|p| p.is_finite() && p.min_element() >= 0.0)
+        );
+        measure(&r.image, &reference).unwrap().relmse
+    };
+    let (noisy, guided, color) = (run(Denoise::None), run(Denoise::Oidn), run(Denoise::OidnColor));
+    assert!(
+        guided < 0.5 * noisy && color < 0.5 * noisy,
+        "noisy {noisy}, guided {guided}, colour {color}"
+    );
+}
