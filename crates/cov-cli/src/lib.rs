@@ -9,8 +9,10 @@
 //! - `covtrace stiff [--length N]`: the stiff suite (cov-stiff): extreme chains in both
 //!   forms and in plain f64, against a double-double reference.
 //! - `covtrace list`: the registered operators with their parameters and units.
-//! - `covtrace render SCENE.ron [--spp N] [-o OUT.exr]`: a uniform render, with the
-//!   covariance pass's density and filter maps.
+//! - `covtrace render SCENE.ron [--method M] [--spp N] [--time S] [--denoise D] [-o OUT.exr]`:
+//!   a render through the library's `Renderer`, with covariance tracing by default
+//!   (`--method cov`); writes the image, the covariance pass's density and filter maps,
+//!   and the feature images a denoiser takes ([`mod@render`]).
 //! - `covtrace render-check SCENE.ron`: predicted against measured local spectra, tile by tile.
 //! - `covtrace render-bench SCENE.ron [--budgets 2,4,…] [-o DIR]`: every sampling and
 //!   reconstruction method against a cached reference: error against time, the equal-error
