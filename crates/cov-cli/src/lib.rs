@@ -19,14 +19,20 @@
 //!   speed-up, an equal-time strip ([`mod@bench`]).
 //!
 //! Every error is one line, `file:line:column: message`, with exit code 2.
+//!
+//! The command line is also a library entry, [`run_with`]: a binary of a few lines gives
+//! all of it with a third party's operators registered next to the built-in ones
+//! (`examples/third_party`).
 
 #![warn(missing_docs)]
 
 pub mod bench;
+mod cli;
 pub mod plot;
 pub mod render;
 pub mod report;
 
+pub use cli::run_with;
 use covtrace::path::Evaluation;
 
 /// The human-readable table of an evaluation.

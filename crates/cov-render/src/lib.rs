@@ -34,7 +34,7 @@
 //! | [`adaptive`] | sample allocation and per-pixel filters from the maps |
 //! | [`renderer`] | one renderer for every method: [`Renderer`], [`RenderSettings`] |
 //! | [`denoise`] | Intel Open Image Denoise after reconstruction (feature `oidn`) |
-//! | [`metrics`], [`bench`] | image error against a reference; error against time |
+//! | [`metrics`], [`mod@bench`] | image error against a reference; error against time |
 //! | [`output`], [`validate`] | files written; the maps checked against reference images |
 //!
 //! Errors are [`RenderError`]s (scene errors are positioned [`SceneError`]s), one line each.

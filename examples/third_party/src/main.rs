@@ -1,26 +1,6 @@
-//! Evaluates a RON path that uses the third-party `Sparkle` operator next to the
-//! built-in ones: `cargo run -p covtrace-sparkle -- examples/third_party/glitter.ron`.
+//! The `covtrace` command line with the third-party `Sparkle` operator next to the
+//! built-in ones: `cargo run -- eval glitter.ron`, `-- list`, `-- plot glitter.ron -o g.png`.
 
-use std::process::ExitCode;
-
-fn main() -> ExitCode {
-    let file = std::env::args()
-        .nth(1)
-        .unwrap_or_else(|| "examples/third_party/glitter.ron".into());
-    let mut registry = covtrace::registry();
-    covtrace_sparkle::register(&mut registry);
-    let result = covtrace::path::Path::load(std::path::Path::new(&file), &registry).and_then(|p| p.eval());
-    match result {
-        Ok(e) => {
-            println!("{file}: layout {} ({})", e.layout, e.axes.join(","));
-            for s in &e.steps {
-                println!("  {:<10} bandwidths {:?}", s.operator, s.bandwidths);
-            }
-            ExitCode::SUCCESS
-        }
-        Err(err) => {
-            eprintln!("covtrace-sparkle: {err}");
-            ExitCode::from(2)
-        }
-    }
+fn main() -> std::process::ExitCode {
+    cov_cli::run_with(|r| covtrace_sparkle::register(r))
 }

@@ -37,3 +37,54 @@ fn bad_sparkle_parameter_is_positioned() {
     assert!(err.to_string().starts_with("<string>:1:"), "{err}");
     assert!(err.to_string().contains("flake"), "{err}");
 }
+
+/// The operator in every layout (2 to 5) and both forms of Σ, against its closed form:
+/// the flakes add `1/(4π² flake²)` to every spatial variance.
+#[test]
+fn sparkle_in_every_layout_and_form() {
+    let mut registry = covtrace::registry();
+    covtrace_sparkle::register(&mut registry);
+    let want = 1.0 / (covtrace::FOUR_PI_SQ * 0.002 * 0.002);
+    for layout in 2..=5usize {
+        let text = format!(
+            "Path(layout: {layout}, source: Gaussian(x: 1.0), operators: [Sparkle(flake: 0.002, spread: 0.01)])"
+        );
+        let path = covtrace::path::Path::parse(&text, &registry).expect("parses");
+        for form in [covtrace::Form::SquareRoot, covtrace::Form::Covariance] {
+            let e = path.eval_in(form).expect("evaluates");
+            assert_eq!(e.layout, layout);
+            let before = e.start.get(0, 0);
+            let after = e.steps[0].matrix.get(0, 0);
+            assert!(
+                ((after - before) - want).abs() <= 1e-9 * want,
+                "layout {layout} {form:?}: {after} - {before} vs {want}"
+            );
+        }
+    }
+}
+
+/// The package's binary is covtrace's command line with `Sparkle` registered.
+#[test]
+fn the_binary_runs_eval_list_and_plot_with_sparkle() {
+    let run = |args: &[&str]| {
+        std::process::Command::new(env!("CARGO_BIN_EXE_covtrace-sparkle"))
+            .current_dir(env!("CARGO_MANIFEST_DIR"))
+            .args(args)
+            .output()
+            .expect("runs")
+    };
+    let out = run(&["eval", "glitter.ron"]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(String::from_utf8_lossy(&out.stdout).contains("Sparkle"));
+    let out = run(&["list"]);
+    let list = String::from_utf8_lossy(&out.stdout);
+    assert!(list.contains("Sparkle: glitter") && list.contains("Travel"), "{list}");
+    let png = std::env::temp_dir().join(format!("sparkle-{}.png", std::process::id()));
+    let out = run(&["plot", "glitter.ron", "-o", png.to_str().expect("utf-8")]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(std::fs::metadata(&png).map(|m| m.len() > 0).unwrap_or(false));
+    let _ = std::fs::remove_file(png);
+    let out = run(&["eval", "missing.ron"]);
+    assert_eq!(out.status.code(), Some(2));
+    assert_eq!(String::from_utf8_lossy(&out.stderr).trim_end().lines().count(), 1);
+}

@@ -1,0 +1,257 @@
+//! The `covtrace` command line itself, as a library entry ([`run_with`]), so that a third
+//! party's binary gives the same commands with its own operators.
+
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+use clap::{Parser, Subcommand};
+use covtrace::path::{Path, Registry};
+use indicatif::{ProgressBar, ProgressStyle};
+
+use crate::{format_evaluation, plot, report};
+
+#[derive(Parser)]
+#[command(
+    name = "covtrace",
+    version,
+    about = "Covariance tracing: frequency analysis of light transport"
+)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Trace a RON path: Σ after every step.
+    Eval {
+        /// The path file.
+        path: PathBuf,
+        /// Print JSON (axis names, every step's matrix, the final matrix).
+        #[arg(long)]
+        json: bool,
+        /// How Σ is held while tracing: square-root (default, the accurate form) or
+        /// covariance (cheaper kernels).
+        #[arg(long, value_enum, default_value_t = FormArg::SquareRoot)]
+        form: FormArg,
+    },
+    /// Draw the spectrum ellipses after every step.
+    Plot {
+        /// The path file.
+        path: PathBuf,
+        /// Output PNG.
+        #[arg(short, long)]
+        output: PathBuf,
+    },
+    /// The brute-force error-against-run-time report.
+    Validate {
+        /// Add the 512-point grid (slow).
+        #[arg(long)]
+        full: bool,
+        /// Output chart (SVG; a PNG is written beside it).
+        #[arg(short, long, default_value = "validate_report.svg")]
+        output: String,
+    },
+    /// The registered operators and their parameters.
+    List,
+    /// Check the covariance pass against a reference render: the local spectrum of each
+    /// 16×16 tile against the predicted bandwidth.
+    RenderCheck(crate::render::CheckArgs),
+    /// Render a scene (RON) with covariance tracing (by default; --method picks another
+    /// method): the covariance pass, samples where it predicts detail, per-pixel filters
+    /// from Σ; writes the image (EXR and PNG) and the density and filter maps.
+    Render(crate::render::RenderArgs),
+    /// Image error against run time: every sampling and reconstruction method (uniform,
+    /// Gaussian, variance-driven, covariance-driven) at several budgets against a cached
+    /// reference; writes CSV/JSON, the error-time chart and an equal-time strip.
+    RenderBench(crate::bench::BenchArgs),
+    /// The stiff suite: extreme chains in both forms and plain f64 against a
+    /// double-double reference.
+    Stiff {
+        /// Length of the long chains.
+        #[arg(long, default_value_t = 10_000)]
+        length: usize,
+    },
+}
+
+/// `--form` values.
+#[derive(Clone, Copy, clap::ValueEnum)]
+enum FormArg {
+    /// Σ = L Lᵀ, updated by array algorithms.
+    SquareRoot,
+    /// Σ itself.
+    Covariance,
+}
+
+impl From<FormArg> for covtrace::Form {
+    fn from(f: FormArg) -> Self {
+        match f {
+            FormArg::SquareRoot => covtrace::Form::SquareRoot,
+            FormArg::Covariance => covtrace::Form::Covariance,
+        }
+    }
+}
+
+/// Prints a line; a closed pipe (`covtrace list | head`) is not an error.
+macro_rules! say {
+    ($($t:tt)*) => {
+        emit(&format!($($t)*))?
+    };
+}
+
+/// Writes a line to standard output. A closed pipe (`covtrace list | head`) ends the output
+/// quietly; any other failure (a full disk, `> /dev/full`) is an error.
+fn emit(line: &str) -> Result<(), String> {
+    use std::io::Write;
+    let mut out = std::io::stdout().lock();
+    match writeln!(out, "{line}").and_then(|()| out.flush()) {
+        Ok(()) => Ok(()),
+        Err(e) if e.kind() == std::io::ErrorKind::BrokenPipe => Ok(()),
+        Err(e) => Err(format!("cannot write the output: {e}")),
+    }
+}
+
+/// Clap's message for a bad command line, in one line: its error and tips, without the
+/// usage block (`covtrace X --help` shows that).
+fn one_line_usage_error(e: &clap::Error) -> String {
+    let text = e.render().to_string();
+    let parts: Vec<String> = text
+        .lines()
+        .take_while(|l| !l.starts_with("Usage:"))
+        .map(str::trim)
+        .filter(|l| !l.is_empty() && !l.starts_with("For more information"))
+        .map(|l| {
+            let l = l.strip_prefix("error: ").unwrap_or(l);
+            l.strip_prefix("tip: ").unwrap_or(l).to_string()
+        })
+        .collect();
+    format!("{} (see --help)", parts.join("; "))
+}
+
+/// Runs the `covtrace` command line on this process's arguments, with the built-in
+/// operators and those `register` adds: a third party's `main` is
+/// `fn main() -> std::process::ExitCode { crate::run_with(|r| my_ops::register(r)) }`
+/// and gets `eval`, `plot`, `list`, `validate` (and the rest) with its operators next to
+/// the built-in ones, with covtrace's output and one-line errors (exit code 2).
+pub fn run_with(register: impl FnOnce(&mut Registry)) -> ExitCode {
+    let cli = match Cli::try_parse() {
+        Ok(cli) => cli,
+        Err(e) if !e.use_stderr() => e.exit(),
+        Err(e) => {
+            eprintln!("covtrace: {}", one_line_usage_error(&e));
+            return ExitCode::from(2);
+        }
+    };
+    let mut registry = covtrace::registry();
+    register(&mut registry);
+    match run(cli, &registry) {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(message) => {
+            eprintln!("covtrace: {message}");
+            ExitCode::from(2)
+        }
+    }
+}
+
+fn json_with_decisions(
+    e: &covtrace::path::Evaluation,
+    d: Option<&covtrace::sensor::PixelDecisions>,
+) -> String {
+    match d {
+        None => e.to_json(),
+        Some(d) => {
+            let mut v = serde_json::to_value(e).unwrap_or_default();
+            if let (Some(obj), Ok(dv)) = (v.as_object_mut(), serde_json::to_value(d)) {
+                obj.insert("pixel".into(), dv);
+            }
+            serde_json::to_string_pretty(&v).unwrap_or_default()
+        }
+    }
+}
+
+fn run(cli: Cli, registry: &Registry) -> Result<(), String> {
+    match cli.command {
+        Command::Eval { path, json, form } => {
+            let p = Path::load(&path, registry).map_err(|e| e.to_string())?;
+            let name = path.display().to_string();
+            let e = p.eval_in(form.into()).map_err(|e| e.to_string())?;
+            // A sensor reports its per-pixel decisions as a typed value of the evaluation.
+            let decisions = e.report::<covtrace::sensor::PixelDecisions>().cloned();
+            if json {
+                say!("{}", json_with_decisions(&e, decisions.as_ref()));
+            } else {
+                say!("{}", format_evaluation(&name, &e).trim_end());
+                if let Some(d) = decisions {
+                    say!("\n{}", crate::format_decisions(&d).trim_end());
+                }
+            }
+        }
+        Command::Plot { path, output } => {
+            crate::render::check_output(&output, "png")?;
+            let p = Path::load(&path, registry).map_err(|e| e.to_string())?;
+            let e = p.eval().map_err(|e| e.to_string())?;
+            let legend = plot::plot(&e, &path.display().to_string(), &output)?;
+            say!("{}", legend.trim_end());
+            say!("written to {}", output.display());
+        }
+        Command::Validate { full, output } => {
+            // The chart is written as SVG and as PNG beside it; both paths are checked first.
+            let out = std::path::PathBuf::from(&output);
+            crate::render::check_output(&out, "svg")?;
+            let png = out.with_extension("png");
+            let sizes = report::sizes(full);
+            let total = report::cases().map_err(|e| e.to_string())?.len() * sizes.len();
+            let bar = ProgressBar::new(total as u64);
+            bar.set_style(
+                ProgressStyle::with_template("{bar:40} {pos}/{len} {msg} [{elapsed}]")
+                    .unwrap_or_else(|_| ProgressStyle::default_bar()),
+            );
+            say!("{}", report::header());
+            let rows = report::run(&sizes, |r| {
+                if bar.is_hidden() {
+                    // A failed write shows at the next line printed outside this callback.
+                    let _ = emit(&report::line(r));
+                } else {
+                    bar.println(report::line(r));
+                }
+                bar.set_message(r.case);
+                bar.inc(1);
+            })
+            .map_err(|e| e.to_string())?;
+            bar.finish_and_clear();
+            report::chart(&output, &rows).map_err(|e| format!("{output}: {e}"))?;
+            let png_name = png.display().to_string();
+            report::chart(&png_name, &rows).map_err(|e| format!("{png_name}: {e}"))?;
+            say!("chart written to {output} and {png_name}");
+        }
+        Command::Stiff { length } => {
+            let cases = cov_stiff::cases(length);
+            let bar = ProgressBar::new(cases.len() as u64);
+            let mut outcomes = Vec::with_capacity(cases.len());
+            for case in &cases {
+                bar.set_message(case.name.clone());
+                outcomes.push(cov_stiff::run_case(case));
+                bar.inc(1);
+            }
+            bar.finish_and_clear();
+            say!("{}", cov_stiff::report(&outcomes).trim_end());
+        }
+        Command::Render(args) => say!("{}", crate::render::run(&args)?.trim_end()),
+        Command::RenderBench(args) => say!("{}", crate::bench::bench(&args)?.trim_end()),
+        Command::RenderCheck(args) => say!("{}", crate::render::check(&args)?.trim_end()),
+        Command::List => {
+            for e in registry.entries() {
+                say!("{}: {}", e.name, e.summary);
+                if e.params.is_empty() {
+                    say!("    (no parameters: write `{0}` or `{0}()`)", e.name);
+                }
+                for p in e.params {
+                    let default = p.default.map(|d| format!(" (default {d})")).unwrap_or_default();
+                    let unit = if p.unit.is_empty() { "–" } else { p.unit };
+                    say!("    {:<10} {:<13} {}{default}", p.name, unit, p.doc);
+                }
+            }
+        }
+    }
+    Ok(())
+}
