@@ -4,12 +4,12 @@
 
 use std::path::{Path, PathBuf};
 
-use cov_render::covpass::{MAX_COV_PATHS, STRIDES};
+use cov_render::covpass::MAX_COV_PATHS;
 use cov_render::denoise::Denoise;
 use cov_render::film::tile_count;
 use cov_render::output::{write_image, write_maps};
-use cov_render::renderer::{MAX_TIME, timed};
-use cov_render::{MAX_SPP, Method, RenderSettings, Renderer, World};
+use cov_render::renderer::timed;
+use cov_render::{MAX_SPP, Method, RenderError, RenderSettings, Renderer, World};
 use indicatif::{ProgressBar, ProgressStyle};
 
 /// What `covtrace render` was asked (parsed by clap).
@@ -96,29 +96,7 @@ pub fn parse_method(s: &str) -> Result<Method, String> {
 /// # Errors
 /// `--spp`, `--time`, `--cov-paths` or `--cov-stride` out of range.
 pub fn settings(a: &RenderArgs) -> Result<RenderSettings, String> {
-    if a.spp == 0 || a.spp > MAX_SPP {
-        return Err(format!("--spp must be 1 to {MAX_SPP}, got {}", a.spp));
-    }
-    if let Some(t) = a.time
-        && !(t.is_finite() && t > 0.0 && t <= MAX_TIME)
-    {
-        return Err(format!(
-            "--time must be more than 0 and at most {MAX_TIME} seconds, got {t}"
-        ));
-    }
-    if !(1..=MAX_COV_PATHS).contains(&a.cov_paths) {
-        return Err(format!(
-            "--cov-paths must be 1 to {MAX_COV_PATHS}, got {}",
-            a.cov_paths
-        ));
-    }
-    if !STRIDES.contains(&a.cov_stride) {
-        return Err(format!(
-            "--cov-stride must be one of {STRIDES:?}, got {}",
-            a.cov_stride
-        ));
-    }
-    Ok(RenderSettings {
+    let s = RenderSettings {
         method: a.method,
         spp: f64::from(a.spp),
         seed: a.seed,
@@ -127,7 +105,15 @@ pub fn settings(a: &RenderArgs) -> Result<RenderSettings, String> {
         cov_stride: a.cov_stride,
         max_luminance: f64::INFINITY,
         denoise: a.denoise,
-    })
+    };
+    // The library's own check, its setting named as the flag the user wrote.
+    s.check().map_err(|e| match e {
+        RenderError::Setting { name, expected, got } => {
+            format!("--{} must be {expected}, got {got}", name.replace('_', "-"))
+        }
+        other => other.to_string(),
+    })?;
+    Ok(s)
 }
 
 /// Parses `WIDTHxHEIGHT`.

@@ -124,16 +124,24 @@ pub const ECHO_MAX: usize = 64;
 /// never becomes a 50 MB error line.
 pub fn echo(s: &str) -> String {
     let n = s.chars().count();
-    let mut out = String::new();
-    for c in s.chars().take(ECHO_MAX) {
+    let mut out = one_line(&s.chars().take(ECHO_MAX).collect::<String>());
+    if n > ECHO_MAX {
+        out.push_str(&format!("… ({n} characters)"));
+    }
+    out
+}
+
+/// `s` on one line, whole: control characters (a line break, a tab, an escape) written as
+/// escapes (`\n`, `\t`, `\u{1b}`), everything else as it is. For text that is not the
+/// user's to bound (a file path, a library's message); [`echo`] also cuts.
+pub fn one_line(s: &str) -> String {
+    let mut out = String::with_capacity(s.len());
+    for c in s.chars() {
         if c.is_control() {
             out.extend(c.escape_default());
         } else {
             out.push(c);
         }
-    }
-    if n > ECHO_MAX {
-        out.push_str(&format!("… ({n} characters)"));
     }
     out
 }

@@ -85,7 +85,7 @@ pub use axis::{Axis, AxisSet, axis_index, layout_axes, layout_set};
 pub use batch::{CHUNK, LANES, StateOps, eval_batch_typed, eval_batch_with};
 pub use cov::{Cov, DIRAC_RELATIVE_SIZE, FOUR_PI_SQ, PSD_RTOL, Validity};
 pub use cov_derive::OperatorSpec;
-pub use error::{CovError, ECHO_MAX, echo, line_col, num, utf8_error_at};
+pub use error::{CovError, ECHO_MAX, echo, line_col, num, one_line, utf8_error_at};
 pub use form::{CovFactor, ROW_SNAP, SCHUR_SNAP};
 pub use lanes::CovLanes;
 pub use operator::{Chain, Operator, Step, Trace, check_layout};

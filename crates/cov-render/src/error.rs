@@ -73,8 +73,8 @@ impl RenderError {
     /// A file error for `path`.
     pub fn file(path: &std::path::Path, e: impl std::fmt::Display) -> RenderError {
         RenderError::File {
-            path: one_line(&path.display().to_string()),
-            message: one_line(&e.to_string()),
+            path: cov_core::one_line(&path.display().to_string()),
+            message: cov_core::one_line(&e.to_string()),
         }
     }
 
@@ -90,14 +90,4 @@ impl RenderError {
             got: crate::echo(&got.to_string()),
         }
     }
-}
-
-/// `s` on one line: line breaks and other control characters escaped.
-pub(crate) fn one_line(s: &str) -> String {
-    s.chars()
-        .flat_map(|c| {
-            let esc = c.is_control().then(|| c.escape_default());
-            esc.into_iter().flatten().chain((!c.is_control()).then_some(c))
-        })
-        .collect()
 }

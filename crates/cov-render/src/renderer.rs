@@ -307,8 +307,7 @@ impl<'w> Renderer<'w> {
         let tiles = crate::film::tile_count(self.world);
         let s = &self.settings;
         let cov = usize::from(s.method.uses_covariance() && self.guide.is_none());
-        let pilot = (s.spp / 4.0).floor().max(2.0);
-        let passes = if s.method == Method::Variance && s.spp >= pilot + 1.0 {
+        let passes = if s.method == Method::Variance && variance_pilot(s.spp).is_some() {
             2
         } else {
             1
@@ -366,16 +365,11 @@ impl<'w> Renderer<'w> {
         });
         match method {
             Method::Variance => {
-                // A pilot of a quarter of the budget (at least 2 samples, for a variance),
-                // then counts ∝ the relative standard deviation (blurred over 3×3 pixels),
-                // at least the pilot: the allocation that minimises the summed relative
-                // variance Σ σᵢ²/(nᵢ(μᵢ² + ε)) for a fixed total.
-                let pilot = (s.spp / 4.0).floor().max(2.0);
-                if s.spp < pilot + 1.0 {
-                    sample(&mut film, &counts, &mut timing);
-                } else {
-                    sample(&mut film, &vec![pilot as u32; n], &mut timing);
-                    let p = pilot as u32;
+                // Counts ∝ the relative standard deviation (blurred over 3×3 pixels) after
+                // the pilot, at least the pilot: the allocation that minimises the summed
+                // relative variance Σ σᵢ²/(nᵢ(μᵢ² + ε)) for a fixed total.
+                if let Some(p) = variance_pilot(s.spp) {
+                    sample(&mut film, &vec![p; n], &mut timing);
                     let (rest, secs) = timed(|| {
                         allocate(&relative_variance(&film), total, p, hi.max(p))
                             .into_iter()
@@ -384,6 +378,8 @@ impl<'w> Renderer<'w> {
                     });
                     timing.allocation += secs;
                     sample(&mut film, &rest, &mut timing);
+                } else {
+                    sample(&mut film, &counts, &mut timing);
                 }
             }
             _ => {
@@ -440,6 +436,13 @@ impl<'w> Renderer<'w> {
             timing,
         })
     }
+}
+
+/// The variance method's pilot: a quarter of the budget, at least 2 samples per pixel
+/// (for a variance); `None` when the budget leaves nothing after it (one uniform pass).
+fn variance_pilot(spp: f64) -> Option<u32> {
+    let pilot = (spp / 4.0).floor().max(2.0);
+    (spp >= pilot + 1.0).then_some(pilot as u32)
 }
 
 /// A uniform render of `spp` samples per pixel with the box filter: plain Monte Carlo

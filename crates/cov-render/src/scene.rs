@@ -365,7 +365,7 @@ impl SceneFile {
         Self::parse_probed(text, None).map_err(|e| SceneError {
             file: file.to_string(),
             at: Some((e.span.start.line, e.span.start.col)),
-            message: crate::error::one_line(&e.code.to_string()),
+            message: cov_core::one_line(&e.code.to_string()),
         })
     }
 

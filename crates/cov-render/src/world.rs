@@ -304,7 +304,7 @@ impl World {
     /// # Errors
     /// An unreadable or oversized file, or any error of [`World::from_text`].
     pub fn load(path: &Path) -> Result<World, SceneError> {
-        let file = crate::error::one_line(&path.display().to_string());
+        let file = cov_core::one_line(&path.display().to_string());
         let err = |message: String| SceneError {
             file: file.clone(),
             at: None,
@@ -647,7 +647,7 @@ fn load_obj(path: &Path, limit: usize) -> Result<Vec<ObjTriangle>, String> {
     if !path.is_file() {
         return Err(format!(
             "no such file: {}",
-            crate::error::one_line(&path.display().to_string())
+            cov_core::one_line(&path.display().to_string())
         ));
     }
     let opts = tobj::LoadOptions {
@@ -655,8 +655,7 @@ fn load_obj(path: &Path, limit: usize) -> Result<Vec<ObjTriangle>, String> {
         single_index: true,
         ..Default::default()
     };
-    let (models, _materials) =
-        tobj::load_obj(path, &opts).map_err(|e| crate::error::one_line(&e.to_string()))?;
+    let (models, _materials) = tobj::load_obj(path, &opts).map_err(|e| cov_core::one_line(&e.to_string()))?;
     let mut out = Vec::new();
     for m in &models {
         let mesh = &m.mesh;
