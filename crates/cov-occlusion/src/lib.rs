@@ -214,6 +214,52 @@ impl Texture {
         let w = window_var(Self::NAME, "feature", feature)?;
         Self::new(w, 0.0, w)
     }
+
+    /// The spectrum of a texture `A` (a reflectance factor) computed from its local
+    /// averages over the footprint around the hit: `mean = ⟨A⟩`, `mean_sq = ⟨A²⟩` and the
+    /// gradient moments `grad = [⟨A_x²⟩, ⟨A_x A_y⟩, ⟨A_y²⟩]` (1/m², derivatives along the
+    /// window's axes). Every input is an average, so a renderer mip-maps them and needs no
+    /// FFT (docs/physics.md section 3, "textures").
+    ///
+    /// With `P = ⟨A²⟩ − ⟨A⟩²` the power of the texture's variation and `G` its gradient
+    /// moments, Parseval gives the second moment of the variation's *power* spectrum,
+    /// `G / (4π² P)`. covtrace's Σ is a moment of the *amplitude* spectrum (section 1),
+    /// where the mean (a Dirac at zero frequency, of mass `|⟨A⟩|`) and the variation (of
+    /// mass `√(2P)` for a sinusoid) are weighed by their amplitudes:
+    ///
+    /// ```text
+    /// W = √(2P) / (|⟨A⟩| + √(2P)) · G / (4π² P)
+    /// ```
+    ///
+    /// This is exact for a sinusoid on a constant, `A = m + a·cos(2π f x)`: `W = |a| f² /
+    /// (|m| + |a|)`. For broadband textures it is the same model, measured against their
+    /// FFT in cov-render's texture tests.
+    ///
+    /// A variation below `1e-12 · ⟨A²⟩` (rounding in the averages of a constant texture)
+    /// gives `W = 0`.
+    ///
+    /// # Errors
+    /// Non-finite or negative `mean_sq`, a non-finite `mean`, gradient moments that are not
+    /// finite or not PSD.
+    pub fn from_moments(mean: f64, mean_sq: f64, grad: [f64; 3]) -> Result<Self, CovError> {
+        CovError::require_finite(Self::NAME, "mean", mean)?;
+        CovError::require_non_negative(Self::NAME, "mean_sq", mean_sq)?;
+        let [gxx, gxy, gyy] = grad;
+        // The same checks as `new`, on the gradient moments.
+        Self::new(gxx, gxy, gyy)?;
+        let p = mean_sq - mean * mean;
+        if p <= 1e-12 * mean_sq {
+            return Self::new(0.0, 0.0, 0.0);
+        }
+        let amp = (2.0 * p).sqrt();
+        let k = amp / (mean.abs() + amp) / (FOUR_PI_SQ * p);
+        Self::new(k * gxx, k * gxy, k * gyy)
+    }
+
+    /// The spectrum covariance `[sxx, sxy, syy]` ((cycles/m)²) this texture adds.
+    pub fn spectrum(&self) -> [f64; 3] {
+        self.s
+    }
 }
 
 impl Operator for Texture {

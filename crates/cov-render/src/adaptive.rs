@@ -74,6 +74,15 @@ pub fn allocate(weights: &[f64], total: f64, lo: u32, hi: u32) -> Vec<u32> {
     counts
 }
 
+/// How many pixels' noise a normalised Gaussian filter of covariance `f` `[xx, xy, yy]`
+/// (px²) averages: `1/Σw² = 4π √det f`, at least 1 (a filter narrower than a pixel
+/// averages nothing).
+pub fn filter_area(f: [f64; 3]) -> f64 {
+    let det = f[0] * f[2] - f[1] * f[1];
+    let a = 4.0 * std::f64::consts::PI * det.max(0.0).sqrt();
+    if a.is_finite() { a.max(1.0) } else { 1.0 }
+}
+
 /// The reconstruction filter covariance `[xx, xy, yy]` (px²) of one pixel's Σ: the
 /// Gaussian whose spectrum matches the image's content ([`content`]), from the core's
 /// `reconstruction_filter` (clamped at [`MAX_FILTER`]).

@@ -29,7 +29,7 @@ use cov_core::{AnyCov, Chain, CovError, Form};
 use cov_curvature::Curvature;
 use cov_defocus::{Pinhole, ThinLens};
 use cov_motion::{CameraMotion, Moving, Shutter, ShutterShape};
-use cov_occlusion::BlockerEdge;
+use cov_occlusion::{BlockerEdge, Texture};
 use cov_projection::{RotateFrame, Unproject};
 use cov_sensor::{PixelRates, Sensor, SensorParams};
 use cov_travel::Travel;
@@ -145,13 +145,77 @@ fn source(layout: usize, s: f64) -> Result<AnyCov, CovError> {
     }
 }
 
-/// Traces one covariance path through the pixel point `(px, py)` at time uniform `ut`;
-/// returns the sensor's rates and the path's weight, or `None` when the path sees nothing.
+/// The rectangle of pixels a covariance path predicts for: `x0, y0, x1, y1` (pixel
+/// coordinates, `x1 > x0`, `y1 > y0`).
+pub type Block = [f64; 4];
+
+/// The spectrum of the texture at `hit` in the frame `(x_out, d_out × x_out)` of the
+/// outgoing ray `d_out`: the texture's statistics band-limited at `band` and averaged over
+/// `region` (m on the surface; crate::texture), their derivatives taken from the surface's
+/// `(u, v)` to the tangent plane and then to the ray (the inverse projection `x_surface =
+/// x_ray / cos_o` along the plane of incidence, docs/physics.md section 3), and
+/// `Texture::from_moments`. `None` without a texture or where the surface's coordinates
+/// are degenerate.
+fn texture_window(
+    world: &World,
+    hit: &Hit,
+    d_out: DVec3,
+    x_out: DVec3,
+    (band, region): (f64, f64),
+) -> Result<Option<Texture>, CovError> {
+    let Some((tex, per_m)) = world.texture_at(hit) else {
+        return Ok(None);
+    };
+    let cos_o = hit.n.dot(d_out).clamp(1e-6, 1.0);
+    let e1 = (x_out - hit.n * x_out.dot(hit.n)).normalize_or_zero();
+    let e2 = d_out.cross(x_out);
+    // Tangent coordinates from (u, v): s = M·(u, v).
+    let [du, dv] = hit.dpduv;
+    let (m00, m01, m10, m11) = (e1.dot(du), e1.dot(dv), e2.dot(du), e2.dot(dv));
+    let det = m00 * m11 - m01 * m10;
+    // Relative to the map's own scale: below it (u, v) does not determine the position.
+    let scale = m00 * m00 + m01 * m01 + m10 * m10 + m11 * m11;
+    if det.abs() <= 1e-12 * scale || !det.is_finite() {
+        return Ok(None);
+    }
+    // J = ∂(u, v)/∂(x, y) of the ray = M⁻¹ · diag(1/cos_o, 1).
+    let j = [[m11 / det / cos_o, -m01 / det], [-m10 / det / cos_o, m00 / det]];
+    // Jᵀ G J.
+    let to_ray = |g: [f64; 3]| -> [f64; 3] {
+        let g = [[g[0], g[1]], [g[1], g[2]]];
+        let jgj = |a: usize, b: usize| -> f64 {
+            let mut acc = 0.0;
+            for (r, gr) in g.iter().enumerate() {
+                for (c, grc) in gr.iter().enumerate() {
+                    acc += j[r][a] * grc * j[c][b];
+                }
+            }
+            acc
+        };
+        [jgj(0, 0), jgj(0, 1), jgj(1, 1)]
+    };
+    // The block predicts for all its pixels the sharpest detail found in it, along each
+    // axis of the ray's frame: the largest `sxx` and `syy` of the lookups (their
+    // correlations, which differ from lookup to lookup, are dropped).
+    let (mut sxx, mut syy) = (0.0f64, 0.0f64);
+    for m in tex.moments(hit.uv, band * per_m, region * per_m) {
+        let [xx, _, yy] = Texture::from_moments(m.mean, m.mean_sq, to_ray(m.grad))?.spectrum();
+        sxx = sxx.max(xx);
+        syy = syy.max(yy);
+    }
+    let best = Some(Texture::new(sxx, 0.0, syy)?);
+    Ok(best)
+}
+
+/// Traces one covariance path through the pixel point `(px, py)` of `block` at time
+/// uniform `ut`; returns the sensor's rates and the path's weight, or `None` when the path
+/// sees nothing. Textures are read over the block's footprint, and edges are looked for
+/// around the path and at the block's corners.
 pub fn trace_path<R: Rng>(
     world: &World,
     cc: &CovCamera,
-    px: f64,
-    py: f64,
+    (px, py): (f64, f64),
+    block: Block,
     ut: f64,
     rng: &mut R,
 ) -> Result<Option<(PixelRates, f64)>, CovError> {
@@ -170,6 +234,15 @@ pub fn trace_path<R: Rng>(
     let weight;
     let start;
     let x_out = frame_x(d_out, hit.n);
+    // Footprints on the surface (m): half a pixel, the finest detail the pixel grid can
+    // show (its Nyquist rate), where textures are band-limited (stretched by the inverse
+    // projection's geometric mean over the two axes); and twice the block's side along
+    // the stretched axis, a square that holds the whole block wherever in it the path
+    // lands, over which the prediction is used and the texture's statistics are averaged.
+    let cos_o = hit.n.dot(d_out).abs().clamp(1e-6, 1.0);
+    let pitch = 2.0 * cam.tan_x * hit.t / cam.width as f64;
+    let side = (block[2] - block[0]).max(block[3] - block[1]).max(1.0);
+    let footprint = (0.5 * pitch / cos_o.sqrt(), 2.0 * side * pitch / cos_o);
     if let Some(li) = hit.light {
         // A light seen directly: its window, seen at the angle of the camera ray.
         let light = &world.lights[li as usize];
@@ -181,7 +254,7 @@ pub fn trace_path<R: Rng>(
         let pick = ((rng.random::<f64>() * n_l as f64) as usize).min(n_l - 1);
         let light = &world.lights[pick];
         let ls = light.sample(hit.p, rng.random(), rng.random());
-        let mat = &world.materials[hit.material as usize];
+        let mat = &world.material_at(&hit, footprint.0);
         let (cos_i, f) = ls.map_or((0.0, DVec3::ZERO), |ls| {
             (hit.n.dot(ls.wi), mat.eval(hit.n, d_out, ls.wi))
         });
@@ -215,14 +288,20 @@ pub fn trace_path<R: Rng>(
                 mat.lobe(),
                 t_out.dot(y_in).atan2(t_out.dot(t_in)),
             )?;
+            // The texture multiplies the reflected light where it leaves the surface (it
+            // commutes with the lobe: a window in position, a convolution in angle).
+            let mut at_surface = Chain::new().with(bounce);
+            if let Some(t) = texture_window(world, &hit, d_out, x_out, footprint)? {
+                at_surface.push(t);
+            }
             if motion && hit.velocity != DVec3::ZERO {
                 chain.push(Moving::new(
                     in_frame(hit.velocity, d_out, x_out),
                     [0.0, 0.0],
-                    Chain::new().with(bounce),
+                    at_surface,
                 )?);
             } else {
-                chain.push(bounce);
+                chain.push(at_surface);
             }
         } else {
             // The light sample does not reach this side: what the camera sees here is
@@ -230,11 +309,22 @@ pub fn trace_path<R: Rng>(
             // camera side (silhouettes, defocus, motion) still counts, with weight 0.
             weight = 0.0;
             start = AnyCov::zeros(cc.layout)?;
+            if let Some(t) = texture_window(world, &hit, d_out, x_out, footprint)? {
+                if motion && hit.velocity != DVec3::ZERO {
+                    chain.push(Moving::new(
+                        in_frame(hit.velocity, d_out, x_out),
+                        [0.0, 0.0],
+                        Chain::new().with(t),
+                    )?);
+                } else {
+                    chain.push(t);
+                }
+            }
         }
     }
     // 4. Travel to the camera, past the nearest silhouette.
     let x_cam = frame_x(d_out, cam.right);
-    match nearest_silhouette(world, &hit, px, py, time, ut) {
+    match nearest_silhouette(world, &hit, (px, py), block, time, ut) {
         Some(e) => {
             chain.push(Travel::new((hit.t - e.depth).max(0.0))?);
             let edge = BlockerEdge::new(e.radius)?;
@@ -333,18 +423,52 @@ struct Silhouette {
     velocity: DVec3,
 }
 
-/// An edge around the pixel: auxiliary pinhole rays half a pixel away that see something
-/// else, a surface at a clearly different depth (more than [`DEPTH_JUMP`] relative) or
-/// nothing (a silhouette), a surface turned by more than `acos(`[`CREASE_COS`]`)` (a
-/// crease, where shading changes abruptly), or an emitter where the path sees none (the
-/// edge of a light) or the reverse. The edge lies at the nearer surface's depth, at the
-/// probe's distance from the path there.
-fn nearest_silhouette(world: &World, hit: &Hit, px: f64, py: f64, time: f64, ut: f64) -> Option<Silhouette> {
+/// Whether two hits see the same surface: the same material (or two materials with the
+/// same parameters and texture), or both the same emitter.
+fn same_surface(world: &World, a: &Hit, b: &Hit) -> bool {
+    if a.light.is_some() || b.light.is_some() {
+        return a.light == b.light;
+    }
+    let (i, j) = (a.material as usize, b.material as usize);
+    i == j
+        || (world.materials.get(i) == world.materials.get(j)
+            && world.material_textures.get(i) == world.material_textures.get(j))
+}
+
+/// An edge around the pixel: auxiliary pinhole rays half a pixel away from the path, and
+/// at the centres of the block's corner pixels, that see something else: a surface at a
+/// clearly different depth (more than [`DEPTH_JUMP`] relative) or nothing (a
+/// silhouette), a surface turned by more than `acos(`[`CREASE_COS`]`)` (a crease, where
+/// shading changes abruptly), another material (a step in reflectance), or an emitter
+/// where the path sees none (the edge of a light) or the reverse. The edge lies at the
+/// nearer surface's depth, half a pixel's footprint from the path there: a block that holds
+/// an edge predicts it for all its pixels.
+fn nearest_silhouette(
+    world: &World,
+    hit: &Hit,
+    (px, py): (f64, f64),
+    block: Block,
+    time: f64,
+    ut: f64,
+) -> Option<Silhouette> {
     let cam = &world.camera;
     let mut best: Option<Silhouette> = None;
-    let offsets = [(0.5, 0.0), (-0.5, 0.0), (0.0, 0.5), (0.0, -0.5)];
-    for &(dx, dy) in offsets.iter().take(EDGE_PROBES) {
-        let r = cam.ray(px + dx, py + dy, (0.5, 0.5), ut);
+    let around = [(0.5, 0.0), (-0.5, 0.0), (0.0, 0.5), (0.0, -0.5)];
+    let [x0, y0, x1, y1] = block;
+    let corners = [
+        (x0 + 0.5, y0 + 0.5),
+        (x1 - 0.5, y0 + 0.5),
+        (x0 + 0.5, y1 - 0.5),
+        (x1 - 0.5, y1 - 0.5),
+    ];
+    let big = x1 - x0 > 1.0 || y1 - y0 > 1.0;
+    let probes = around
+        .iter()
+        .take(EDGE_PROBES)
+        .map(|&(dx, dy)| (px + dx, py + dy))
+        .chain(corners.into_iter().filter(|_| big));
+    for (qx, qy) in probes {
+        let r = cam.ray(qx, qy, (0.5, 0.5), ut);
         let h = world
             .geometry
             .intersect(r.origin, r.dir, time, 0.0, f64::INFINITY);
@@ -352,7 +476,7 @@ fn nearest_silhouette(world: &World, hit: &Hit, px: f64, py: f64, time: f64, ut:
             Some(h2)
                 if (h2.t - hit.t).abs() <= DEPTH_JUMP * hit.t
                     && h2.n.dot(hit.n) >= CREASE_COS
-                    && h2.light.is_some() == hit.light.is_some() =>
+                    && same_surface(world, hit, &h2) =>
             {
                 continue;
             }
@@ -362,9 +486,8 @@ fn nearest_silhouette(world: &World, hit: &Hit, px: f64, py: f64, time: f64, ut:
             ),
             None => (hit.t, hit.velocity),
         };
-        // Distance between the two camera rays at that depth: half a pixel's footprint.
-        let pitch = 2.0 * cam.tan_x * depth / cam.width as f64;
-        let radius = (pitch * (dx.abs() + dy.abs())).max(1e-9);
+        // Half a pixel's footprint at that depth.
+        let radius = (cam.tan_x * depth / cam.width as f64).max(1e-9);
         if best.as_ref().is_none_or(|b| radius < b.radius) {
             best = Some(Silhouette {
                 depth,
@@ -514,11 +637,13 @@ fn block_cov<R: Rng>(
             rng.random::<f64>(),
         );
         let (px, py) = (f64::from(x) + jx, f64::from(y) + jy);
-        let r = trace_path(world, cc, px, py, ut, rng).map_err(|e| crate::RenderError::Covariance {
-            x: px.floor() as u32,
-            y: py.floor() as u32,
-            message: e.to_string(),
-        })?;
+        let block = [f64::from(x), f64::from(y), f64::from(x + sx), f64::from(y + sy)];
+        let r =
+            trace_path(world, cc, (px, py), block, ut, rng).map_err(|e| crate::RenderError::Covariance {
+                x: px.floor() as u32,
+                y: py.floor() as u32,
+                message: e.to_string(),
+            })?;
         let Some((d, wgt)) = r else { continue };
         let s = [d.image_cov_px[0][0], d.image_cov_px[0][1], d.image_cov_px[1][1]];
         if !(s.iter().all(|v| v.is_finite()) && d.samples_per_pixel.is_finite()) {

@@ -4,9 +4,10 @@
 //! f64 by the callback. A moving primitive's box covers its whole motion over the shutter,
 //! and the primitive is intersected at the ray's time.
 
+use std::f64::consts::PI;
 use std::time::Duration;
 
-use glam::{DVec3, Vec3A};
+use glam::{DVec2, DVec3, Vec3A};
 use obvhs::BvhBuildParams;
 use obvhs::aabb::Aabb;
 use obvhs::bvh2::Bvh2;
@@ -23,12 +24,14 @@ pub enum Shape {
         /// Radius.
         radius: f64,
     },
-    /// A triangle, with optional vertex normals.
+    /// A triangle, with optional vertex normals and texture coordinates.
     Triangle {
         /// Vertices at time 0.
         v: [DVec3; 3],
         /// Vertex normals.
         n: Option<[DVec3; 3]>,
+        /// Vertex texture coordinates `(u, v)`.
+        uv: Option<[DVec2; 3]>,
     },
 }
 
@@ -66,8 +69,25 @@ pub struct Hit {
     pub material: u32,
     /// Light index for emitters.
     pub light: Option<u32>,
+    /// Texture coordinates `(u, v)` of the hit (0 where the shape has none).
+    pub uv: DVec2,
+    /// `∂p/∂u` and `∂p/∂v` at the hit (m per unit; 0 where the shape has no coordinates
+    /// or they are degenerate).
+    pub dpduv: [DVec3; 2],
 }
 
+/// `(∂p/∂u, ∂p/∂v)` of a triangle with edges `e1, e2` and texture coordinates `uv`
+/// (zero when the coordinates are degenerate).
+fn triangle_dpduv(e1: DVec3, e2: DVec3, uv: [DVec2; 3]) -> [DVec3; 2] {
+    let (d1, d2) = (uv[1] - uv[0], uv[2] - uv[0]);
+    let det = d1.x * d2.y - d2.x * d1.y;
+    // Relative to the coordinates' own scale: below this the map from (u, v) to the
+    // surface is singular to rounding.
+    if det.abs() <= 1e-12 * (d1.length_squared() + d2.length_squared()) {
+        return [DVec3::ZERO; 2];
+    }
+    [(e1 * d2.y - e2 * d1.y) / det, (e2 * d1.x - e1 * d2.x) / det]
+}
 /// The scene's primitives under a BVH.
 pub struct Geometry {
     prims: Vec<Prim>,
@@ -148,28 +168,41 @@ impl Prim {
 
     fn hit(&self, o: DVec3, d: DVec3, t: f64, time: f64) -> Hit {
         let p = o + d * t;
-        let (n_out, ns_out, curvature) = match self.shape {
+        // The point at rest (shapes move rigidly: their coordinates move with them).
+        let q = p - self.velocity * time;
+        let (n_out, ns_out, curvature, uv, dpduv) = match self.shape {
             Shape::Sphere { center, radius } => {
-                let n = ((p - self.velocity * time) - center) / radius;
-                (n, n, 1.0 / radius)
+                let n = (q - center) / radius;
+                // Longitude u from +x towards +z, latitude v from the south pole (−y).
+                let phi = n.z.atan2(n.x);
+                let theta = n.y.clamp(-1.0, 1.0).acos();
+                let (sp, cp, st, ct) = (phi.sin(), phi.cos(), theta.sin(), theta.cos());
+                let uv = DVec2::new(0.5 + phi / (2.0 * PI), 1.0 - theta / PI);
+                let dpdu = DVec3::new(-st * sp, 0.0, st * cp) * (2.0 * PI * radius);
+                let dpdv = -DVec3::new(ct * cp, -st, ct * sp) * (PI * radius);
+                (n, n, 1.0 / radius, uv, [dpdu, dpdv])
             }
-            Shape::Triangle { v, n } => {
-                let ng = (v[1] - v[0]).cross(v[2] - v[0]).normalize();
+            Shape::Triangle { v, n, uv } => {
+                let (e1, e2) = (v[1] - v[0], v[2] - v[0]);
+                let area = e1.cross(e2);
+                let ng = area.normalize();
+                // Barycentric weights of the hit at rest.
+                let a2 = area.length_squared().max(1e-300);
+                let b1 = (q - v[0]).cross(e2).dot(area) / a2;
+                let b2 = e1.cross(q - v[0]).dot(area) / a2;
+                let b0 = 1.0 - b1 - b2;
                 let ns = match n {
                     Some(vn) => {
-                        // Barycentric weights of the hit at rest.
-                        let q = p - self.velocity * time;
-                        let area = (v[1] - v[0]).cross(v[2] - v[0]);
-                        let a2 = area.length_squared().max(1e-300);
-                        let b1 = (q - v[0]).cross(v[2] - v[0]).dot(area) / a2;
-                        let b2 = (v[1] - v[0]).cross(q - v[0]).dot(area) / a2;
-                        let s = vn[0] * (1.0 - b1 - b2) + vn[1] * b1 + vn[2] * b2;
-                        let s = s.normalize_or_zero();
+                        let s = (vn[0] * b0 + vn[1] * b1 + vn[2] * b2).normalize_or_zero();
                         if s == DVec3::ZERO { ng } else { s }
                     }
                     None => ng,
                 };
-                (ng, ns, 0.0)
+                let (uvh, dp) = match uv {
+                    Some(c) => (c[0] * b0 + c[1] * b1 + c[2] * b2, triangle_dpduv(e1, e2, c)),
+                    None => (DVec2::ZERO, [DVec3::ZERO; 2]),
+                };
+                (ng, ns, 0.0, uvh, dp)
             }
         };
         let front = n_out.dot(d) < 0.0;
@@ -189,6 +222,8 @@ impl Prim {
             velocity: self.velocity,
             material: self.material,
             light: self.light,
+            uv,
+            dpduv,
         }
     }
 }

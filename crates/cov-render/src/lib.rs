@@ -26,6 +26,7 @@
 //! |---|---|
 //! | [`scene`] | the scene description a user writes (RON), checked where it is written |
 //! | [`world`] | the scene as the renderer uses it: camera, lights, materials, geometry |
+//! | [`texture`] | reflectance maps and their mip pyramid of colours and spectra |
 //! | [`geometry`], [`material`] | shapes under a BVH; BRDFs and their covariance lobes |
 //! | [`trace`] | the path tracer's radiance estimate of one camera ray |
 //! | [`sampler`] | each pixel's Owen-scrambled Sobol sequence |
@@ -54,6 +55,7 @@ pub mod output;
 pub mod renderer;
 pub mod sampler;
 pub mod scene;
+pub mod texture;
 pub mod trace;
 pub mod validate;
 pub mod world;

@@ -36,6 +36,11 @@ pub enum Material {
     },
 }
 
+/// Luminance (Rec. 709 weights).
+pub fn luminance(c: DVec3) -> f64 {
+    0.2126 * c.x + 0.7152 * c.y + 0.0722 * c.z
+}
+
 /// An orthonormal basis around `n`.
 pub fn basis(n: DVec3) -> (DVec3, DVec3) {
     let a = if n.x.abs() > 0.9 { DVec3::Y } else { DVec3::X };
@@ -66,6 +71,15 @@ impl Material {
             Material::Diffuse { albedo } | Material::Phong { albedo, .. } | Material::Ggx { albedo, .. } => {
                 albedo
             }
+        }
+    }
+
+    /// The same material with another reflectance (a texture's value at a hit).
+    pub fn with_albedo(&self, albedo: DVec3) -> Material {
+        match *self {
+            Material::Diffuse { .. } => Material::Diffuse { albedo },
+            Material::Phong { exponent, .. } => Material::Phong { albedo, exponent },
+            Material::Ggx { alpha, .. } => Material::Ggx { albedo, alpha },
         }
     }
 

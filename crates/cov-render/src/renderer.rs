@@ -37,7 +37,7 @@
 use std::time::Instant;
 
 use crate::RenderError;
-use crate::adaptive::{Guide, MAX_RATIO, adapted_filters, allocate, relative_variance};
+use crate::adaptive::{Guide, MAX_RATIO, adapted_filters, allocate, filter_area, relative_variance};
 use crate::covpass::{CovMaps, MAX_COV_PATHS, STRIDES, covariance_maps};
 use crate::denoise::Denoise;
 use crate::film::{Film, Filter, Gaussian, Image, MAX_SPP, Progress};
@@ -61,7 +61,9 @@ pub enum Method {
     CovDensity,
     /// Uniform samples, the covariance filter (ablation).
     CovFilter,
-    /// Samples ∝ the covariance density and the covariance filter.
+    /// Covariance tracing: a pilot, then samples ∝ the pilot's relative standard
+    /// deviation over the square root of the pixels the covariance filter averages, and
+    /// the covariance filter.
     Cov,
 }
 
@@ -307,7 +309,8 @@ impl<'w> Renderer<'w> {
         let tiles = crate::film::tile_count(self.world);
         let s = &self.settings;
         let cov = usize::from(s.method.uses_covariance() && self.guide.is_none());
-        let passes = if s.method == Method::Variance && variance_pilot(s.spp).is_some() {
+        let passes = if matches!(s.method, Method::Variance | Method::Cov) && variance_pilot(s.spp).is_some()
+        {
             2
         } else {
             1
@@ -357,21 +360,34 @@ impl<'w> Renderer<'w> {
         };
         // The first pass.
         let (mut counts, t) = timed(|| match (method, guide) {
-            (Method::CovDensity | Method::Cov, Some(g)) => {
+            (Method::CovDensity, Some(g)) => {
                 let lo = ((s.spp / 4.0).floor() as u32).max(1);
                 allocate(&g.density, total, lo, hi)
             }
             _ => allocate(&vec![1.0; n], total, 1, MAX_SPP),
         });
+        // The weights of the allocation after a pilot: the relative standard deviation
+        // (blurred over 3×3 pixels); for covariance tracing, over the square root of the
+        // number of pixels its matched filter averages (`filter_area`). Counts ∝ these
+        // weights minimise the summed relative error Σ σᵢ²/(nᵢ Aᵢ (μᵢ² + ε)) of pixels
+        // whose noise a filter averages over Aᵢ pixels, for a fixed total.
+        let weights = |film: &Film| -> Vec<f64> {
+            let rv = relative_variance(film);
+            match guide {
+                Some(g) if method == Method::Cov => rv
+                    .iter()
+                    .zip(&g.matched)
+                    .map(|(r, f)| r / filter_area(*f).sqrt())
+                    .collect(),
+                _ => rv,
+            }
+        };
         match method {
-            Method::Variance => {
-                // Counts ∝ the relative standard deviation (blurred over 3×3 pixels) after
-                // the pilot, at least the pilot: the allocation that minimises the summed
-                // relative variance Σ σᵢ²/(nᵢ(μᵢ² + ε)) for a fixed total.
+            Method::Variance | Method::Cov => {
                 if let Some(p) = variance_pilot(s.spp) {
                     sample(&mut film, &vec![p; n], &mut timing);
                     let (rest, secs) = timed(|| {
-                        allocate(&relative_variance(&film), total, p, hi.max(p))
+                        allocate(&weights(&film), total, p, hi.max(p))
                             .into_iter()
                             .map(|c| c.saturating_sub(p))
                             .collect::<Vec<u32>>()
@@ -383,7 +399,7 @@ impl<'w> Renderer<'w> {
                 }
             }
             _ => {
-                if matches!(method, Method::CovDensity | Method::Cov) {
+                if method == Method::CovDensity {
                     timing.allocation += t;
                 }
                 sample(&mut film, &counts, &mut timing);
@@ -399,8 +415,8 @@ impl<'w> Renderer<'w> {
                 if elapsed + pass_secs > limit || u64::from(highest) + u64::from(hi) > u64::from(MAX_SPP) {
                     break;
                 }
-                if method == Method::Variance {
-                    let (c, secs) = timed(|| allocate(&relative_variance(&film), total, 1, hi));
+                if matches!(method, Method::Variance | Method::Cov) {
+                    let (c, secs) = timed(|| allocate(&weights(&film), total, 1, hi));
                     timing.allocation += secs;
                     counts = c;
                 }

@@ -29,7 +29,8 @@
 //! | `camera.lens.focal_length` | m | focal length (default 0.05), < focus distance |
 //! | `camera.shutter.open`, `close` | s | shutter interval, `close > open` |
 //! | `camera.velocity` | m/s | camera motion during the shutter |
-//! | `materials` | | named `Diffuse(albedo)`, `Phong(albedo, exponent)`, `Ggx(albedo, alpha)` |
+//! | `textures` | | named `Checker(checks, a, b)`, `Stripes(count, duty, a, b)`, `Noise(cells, a, b, seed)` (generated; `size` texels per side, default 1024), `Image(file)` (PNG or EXR, relative to the scene file); all take `repeat: (u, v)` |
+//! | `materials` | | named `Diffuse(albedo)`, `Phong(albedo, exponent)`, `Ggx(albedo, alpha)`, each with an optional `texture` that multiplies the albedo |
 //! | `lights` | | `Rect(corner, edge_u, edge_v, radiance)`, `Sphere(center, radius, radiance)`; radiance in W/(m² sr) per channel |
 //! | `shapes` | | `Sphere(center, radius, material, velocity)`, `Quad(corner, edge_u, edge_v, material, velocity)`, `Mesh(obj, material, translate, scale, velocity)` |
 
@@ -139,6 +140,9 @@ impl<'de> Deserialize<'de> for Resolution {
 pub struct SceneFile {
     /// The camera.
     pub camera: CameraDesc,
+    /// Named textures (materials refer to them by name).
+    #[serde(default)]
+    pub textures: BTreeMap<At<String>, At<TextureDesc>>,
     /// Named materials.
     #[serde(default)]
     pub materials: BTreeMap<At<String>, MaterialDesc>,
@@ -207,6 +211,9 @@ pub enum MaterialDesc {
     Diffuse {
         /// Reflectance per channel, ≤ 1.
         albedo: Rgb,
+        /// A texture from `textures` that multiplies the albedo.
+        #[serde(default)]
+        texture: Option<At<String>>,
     },
     /// Normalised modified Phong around the mirror direction (the cov-brdf Phong lobe).
     Phong {
@@ -214,6 +221,9 @@ pub enum MaterialDesc {
         albedo: Rgb,
         /// Exponent ≥ 0.
         exponent: NonNegative,
+        /// A texture from `textures` that multiplies the albedo.
+        #[serde(default)]
+        texture: Option<At<String>>,
     },
     /// GGX microfacets (the cov-brdf GGX lobe).
     Ggx {
@@ -221,6 +231,75 @@ pub enum MaterialDesc {
         albedo: Rgb,
         /// Roughness > 0.
         alpha: Positive,
+        /// A texture from `textures` that multiplies the albedo.
+        #[serde(default)]
+        texture: Option<At<String>>,
+    },
+}
+
+/// A texture: a reflectance map over a surface's `(u, v)` (quads: `u` along `edge_u`,
+/// `v` along `edge_v`; spheres: longitude and latitude; meshes: the OBJ's coordinates).
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields, rename = "Texture")]
+pub enum TextureDesc {
+    /// An image file (PNG, sRGB; or EXR, linear), path relative to the scene file.
+    Image {
+        /// The file.
+        file: At<String>,
+        /// Repeats over a unit of `u` and `v` (default 1, 1).
+        #[serde(default)]
+        repeat: Option<(Positive, Positive)>,
+    },
+    /// A checkerboard.
+    Checker {
+        /// Squares along `u` and `v`.
+        checks: (u32, u32),
+        /// The two colours (reflectances).
+        a: Rgb,
+        /// The second colour.
+        b: Rgb,
+        /// Texels per side it is rasterised on (default 1024).
+        #[serde(default)]
+        size: Option<u32>,
+        /// Repeats over a unit of `u` and `v` (default 1, 1).
+        #[serde(default)]
+        repeat: Option<(Positive, Positive)>,
+    },
+    /// Stripes along `v` (bands running along `u`).
+    Stripes {
+        /// Periods over a unit of `v`.
+        count: u32,
+        /// Fraction of each period in colour `b`, centred in it (default 0.5).
+        #[serde(default)]
+        duty: Option<Positive>,
+        /// The background colour.
+        a: Rgb,
+        /// The stripes' colour.
+        b: Rgb,
+        /// Texels per side (default 1024).
+        #[serde(default)]
+        size: Option<u32>,
+        /// Repeats over a unit of `u` and `v` (default 1, 1).
+        #[serde(default)]
+        repeat: Option<(Positive, Positive)>,
+    },
+    /// Smooth value noise between two colours.
+    Noise {
+        /// Lattice cells per side.
+        cells: u32,
+        /// The colour at 0.
+        a: Rgb,
+        /// The colour at 1.
+        b: Rgb,
+        /// Seed of the lattice (default 0).
+        #[serde(default)]
+        seed: Option<u64>,
+        /// Texels per side (default 1024).
+        #[serde(default)]
+        size: Option<u32>,
+        /// Repeats over a unit of `u` and `v` (default 1, 1).
+        #[serde(default)]
+        repeat: Option<(Positive, Positive)>,
     },
 }
 

@@ -21,10 +21,7 @@ pub fn spawn(hit: &Hit, dir: DVec3) -> DVec3 {
     hit.p + hit.ng * (eps * side)
 }
 
-/// Luminance (Rec. 709 weights).
-pub fn luminance(c: DVec3) -> f64 {
-    0.2126 * c.x + 0.7152 * c.y + 0.0722 * c.z
-}
+pub use crate::material::luminance;
 
 /// The radiance a light leaves towards `-dir` at `hit` (one-sided emitters).
 fn emitted(world: &World, hit: &Hit) -> DVec3 {
@@ -34,10 +31,24 @@ fn emitted(world: &World, hit: &Hit) -> DVec3 {
     }
 }
 
-/// Light sampling at a surface hit; with `mis`, weighted against BRDF sampling.
+/// The fraction of a pixel's footprint over which textures are filtered: the pixel's own
+/// samples already average over its area, so a texture lookup blurs only a little more
+/// (pbrt-v4 scales its ray differentials by `max(1/8, 1/√spp)`; 1/8 is that bound).
+pub const TEXTURE_FOOTPRINT: f64 = 0.125;
+
+/// The footprint (m) over which the tracer filters a texture seen at distance `dist` along
+/// the path from the camera: [`TEXTURE_FOOTPRINT`] of a pixel's width at that distance.
+fn footprint(world: &World, dist: f64) -> f64 {
+    let cam = &world.camera;
+    TEXTURE_FOOTPRINT * 2.0 * cam.tan_x * dist / cam.width as f64
+}
+
+/// Light sampling at a surface hit of material `mat`; with `mis`, weighted against BRDF
+/// sampling.
 fn direct<S: Sampler + ?Sized>(
     world: &World,
     hit: &Hit,
+    mat: &crate::material::Material,
     wo: DVec3,
     time: f64,
     rng: &mut S,
@@ -49,7 +60,6 @@ fn direct<S: Sampler + ?Sized>(
     let Some(ls) = light.sample(hit.p, rng.next(), rng.next()) else {
         return DVec3::ZERO;
     };
-    let mat = &world.materials[hit.material as usize];
     let f = mat.eval(hit.n, wo, ls.wi);
     let cos = hit.n.dot(ls.wi);
     if f == DVec3::ZERO || cos <= 0.0 || ls.wi.dot(hit.ng) <= 0.0 {
@@ -129,21 +139,27 @@ pub fn radiance_parts<S: Sampler + ?Sized>(world: &World, ray: &CameraRay, rng: 
             ..RaySample::default()
         };
     }
-    features.albedo = world.materials[hit.material as usize].albedo();
+    let mat = world.material_at(&hit, footprint(world, hit.t));
+    features.albedo = mat.albedo();
     RaySample {
-        reflected: reflected(world, ray, &hit, rng),
+        reflected: reflected(world, ray, &hit, &mat, rng),
         features,
         ..RaySample::default()
     }
 }
 
 /// The light the surface at `hit` reflects towards the camera.
-fn reflected<S: Sampler + ?Sized>(world: &World, ray: &CameraRay, hit: &Hit, rng: &mut S) -> DVec3 {
+fn reflected<S: Sampler + ?Sized>(
+    world: &World,
+    ray: &CameraRay,
+    hit: &Hit,
+    mat: &crate::material::Material,
+    rng: &mut S,
+) -> DVec3 {
     let hit = *hit;
     let wo = -ray.dir;
-    let mut l = direct(world, &hit, wo, ray.time, rng, true);
+    let mut l = direct(world, &hit, mat, wo, ray.time, rng, true);
     // One indirect bounce, by BRDF sampling.
-    let mat = &world.materials[hit.material as usize];
     let Some(wi) = mat.sample(hit.n, wo, rng.next(), rng.next()) else {
         return l;
     };
@@ -167,7 +183,10 @@ fn reflected<S: Sampler + ?Sized>(world: &World, ray: &CameraRay, hit: &Hit, rng
                 l += throughput * le * (pb * pb / (pb * pb + pl * pl));
             }
         }
-        None => l += throughput * direct(world, &h2, -wi, ray.time, rng, false),
+        None => {
+            let mat2 = world.material_at(&h2, footprint(world, hit.t + h2.t));
+            l += throughput * direct(world, &h2, &mat2, -wi, ray.time, rng, false);
+        }
     }
     l
 }

@@ -4,14 +4,15 @@
 use std::f64::consts::PI;
 use std::path::Path;
 
-use glam::DVec3;
+use glam::{DVec2, DVec3};
 
-use crate::geometry::{Geometry, Prim, Shape};
+use crate::geometry::{Geometry, Hit, Prim, Shape};
 use crate::material::{Material, basis};
 use crate::scene::{
-    At, CameraDesc, LightDesc, MAX_SCENE_BYTES, MAX_TRIANGLES, MaterialDesc, SceneError, SceneFile,
-    ShapeDesc, V3,
+    At, CameraDesc, LightDesc, MAX_SCENE_BYTES, MAX_TRIANGLES, MaterialDesc, Rgb, SceneError, SceneFile,
+    ShapeDesc, TextureDesc, V3,
 };
+use crate::texture::TextureMap;
 
 fn v(a: V3) -> DVec3 {
     DVec3::from_array(a.0)
@@ -276,6 +277,10 @@ pub struct World {
     pub materials: Vec<Material>,
     /// Material names, by index.
     pub material_names: Vec<String>,
+    /// Per material, the index of its texture in [`World::textures`].
+    pub material_textures: Vec<Option<u32>>,
+    /// Textures, by index.
+    pub textures: Vec<TextureMap>,
     /// Lights, by index.
     pub lights: Vec<Light>,
     /// Primitives under a BVH.
@@ -297,6 +302,27 @@ impl World {
         self.camera.height = h;
         self.camera.tan_y = self.camera.tan_x * h as f64 / w as f64;
         self
+    }
+
+    /// The material at a surface hit, its albedo multiplied by its texture's colour there,
+    /// averaged over a footprint of `footprint` metres on the surface.
+    pub fn material_at(&self, hit: &Hit, footprint: f64) -> Material {
+        let mat = self.materials[hit.material as usize];
+        match self.texture_at(hit) {
+            Some((tex, per_m)) => mat.with_albedo(mat.albedo() * tex.rgb(hit.uv, footprint * per_m)),
+            None => mat,
+        }
+    }
+
+    /// The texture of the hit's material, with the surface's texture coordinates per metre
+    /// (for footprints); `None` without a texture or where the coordinates are degenerate.
+    pub fn texture_at(&self, hit: &Hit) -> Option<(&TextureMap, f64)> {
+        let t = (*self.material_textures.get(hit.material as usize)?)?;
+        let area = hit.dpduv[0].cross(hit.dpduv[1]).length();
+        // Below this the (u, v) map is singular (a sphere's pole, a degenerate triangle):
+        // the texture's base level is used, without a footprint.
+        let per_m = if area > 1e-300 { 1.0 / area.sqrt() } else { 0.0 };
+        Some((&self.textures[t as usize], per_m))
     }
 
     /// Reads and builds a scene file.
@@ -344,10 +370,12 @@ impl World {
             message,
         };
         let camera = camera(&desc.camera).map_err(|(o, m)| at(o, m))?;
-        let (materials, material_names) = materials(&desc).map_err(|(o, m)| at(o, m))?;
+        let (textures, texture_names) = textures(&desc, dir).map_err(|(o, m)| at(o, m))?;
+        let (materials, material_names, material_textures) =
+            materials(&desc, &Names(&texture_names, "texture")).map_err(|(o, m)| at(o, m))?;
         let mut prims = Vec::new();
         let lights = lights(&desc, &mut prims).map_err(|(o, m)| at(o, m))?;
-        let names = Names(&material_names);
+        let names = Names(&material_names, "material");
         let any_velocity = shapes(&desc, &names, dir, &mut prims).map_err(|(o, m)| at(o, m))?
             || camera.velocity != DVec3::ZERO;
         let (t0, t1) = camera.shutter.unwrap_or((0.0, 0.0));
@@ -357,6 +385,8 @@ impl World {
             camera,
             materials,
             material_names,
+            material_textures,
+            textures,
             lights,
             geometry: Geometry::new(prims, t0, t1),
         })
@@ -437,23 +467,132 @@ fn camera(c: &CameraDesc) -> Result<Camera, Failure> {
     })
 }
 
-/// The materials, and their names, in the order of the file's map.
-fn materials(desc: &SceneFile) -> Result<(Vec<Material>, Vec<String>), Failure> {
+/// A colour of a texture: a reflectance, at most 1 per channel.
+fn reflectance(c: Rgb, name: &At<String>) -> Result<DVec3, Failure> {
+    let c = DVec3::from_array(c.0);
+    if c.max_element() > 1.0 {
+        return Err((
+            name.ordinal,
+            format!(
+                "texture `{}`: a colour above 1 reflects more than it receives",
+                crate::echo(&name.value)
+            ),
+        ));
+    }
+    Ok(c)
+}
+
+/// Largest side of a generated texture, by default (texels).
+pub const DEFAULT_TEXTURE_SIZE: u32 = 1024;
+
+/// The textures, and their names, in the order of the file's map.
+fn textures(desc: &SceneFile, dir: &Path) -> Result<(Vec<TextureMap>, Vec<String>), Failure> {
+    let mut maps = Vec::new();
+    let mut names = Vec::new();
+    for (name, t) in &desc.textures {
+        let rep = |r: &Option<(crate::scene::Positive, crate::scene::Positive)>| {
+            r.map_or(DVec2::ONE, |(a, b)| DVec2::new(a.0, b.0))
+        };
+        let size = |s: &Option<u32>| s.unwrap_or(DEFAULT_TEXTURE_SIZE);
+        let map = match &t.value {
+            TextureDesc::Image { file, repeat } => TextureMap::load(&dir.join(&file.value), rep(repeat))
+                .map_err(|e| {
+                    (
+                        file.ordinal,
+                        format!("texture `{}`: {e}", crate::echo(&name.value)),
+                    )
+                })?,
+            TextureDesc::Checker {
+                checks,
+                a,
+                b,
+                size: sz,
+                repeat,
+            } => TextureMap::checker(
+                *checks,
+                reflectance(*a, name)?,
+                reflectance(*b, name)?,
+                size(sz),
+                rep(repeat),
+            )
+            .map_err(|e| (t.ordinal, format!("texture `{}`: {e}", crate::echo(&name.value))))?,
+            TextureDesc::Stripes {
+                count,
+                duty,
+                a,
+                b,
+                size: sz,
+                repeat,
+            } => TextureMap::stripes(
+                *count,
+                duty.map_or(0.5, |d| d.0),
+                reflectance(*a, name)?,
+                reflectance(*b, name)?,
+                size(sz),
+                rep(repeat),
+            )
+            .map_err(|e| (t.ordinal, format!("texture `{}`: {e}", crate::echo(&name.value))))?,
+            TextureDesc::Noise {
+                cells,
+                a,
+                b,
+                seed,
+                size: sz,
+                repeat,
+            } => TextureMap::noise(
+                *cells,
+                seed.unwrap_or(0),
+                reflectance(*a, name)?,
+                reflectance(*b, name)?,
+                size(sz),
+                rep(repeat),
+            )
+            .map_err(|e| (t.ordinal, format!("texture `{}`: {e}", crate::echo(&name.value))))?,
+        };
+        maps.push(map);
+        names.push(name.value.clone());
+    }
+    Ok((maps, names))
+}
+
+/// The materials, their names and their textures, in the order of the file's map.
+fn materials(
+    desc: &SceneFile,
+    textures: &Names<'_>,
+) -> Result<(Vec<Material>, Vec<String>, Vec<Option<u32>>), Failure> {
     let mut materials = Vec::new();
     let mut names = Vec::new();
+    let mut texs = Vec::new();
     for (name, m) in &desc.materials {
-        let mat = match *m {
-            MaterialDesc::Diffuse { albedo } => Material::Diffuse {
-                albedo: DVec3::from_array(albedo.0),
-            },
-            MaterialDesc::Phong { albedo, exponent } => Material::Phong {
-                albedo: DVec3::from_array(albedo.0),
-                exponent: exponent.0,
-            },
-            MaterialDesc::Ggx { albedo, alpha } => Material::Ggx {
-                albedo: DVec3::from_array(albedo.0),
-                alpha: alpha.0,
-            },
+        let (mat, texture) = match m {
+            MaterialDesc::Diffuse { albedo, texture } => (
+                Material::Diffuse {
+                    albedo: DVec3::from_array(albedo.0),
+                },
+                texture,
+            ),
+            MaterialDesc::Phong {
+                albedo,
+                exponent,
+                texture,
+            } => (
+                Material::Phong {
+                    albedo: DVec3::from_array(albedo.0),
+                    exponent: exponent.0,
+                },
+                texture,
+            ),
+            MaterialDesc::Ggx {
+                albedo,
+                alpha,
+                texture,
+            } => (
+                Material::Ggx {
+                    albedo: DVec3::from_array(albedo.0),
+                    alpha: alpha.0,
+                },
+                texture,
+            ),
         };
         let albedo = mat.albedo();
         if albedo.max_element() > 1.0 {
@@ -465,17 +604,18 @@ fn materials(desc: &SceneFile) -> Result<(Vec<Material>, Vec<String>), Failure> 
                 ),
             ));
         }
+        texs.push(texture.as_ref().map(|t| textures.index(t)).transpose()?);
         materials.push(mat);
         names.push(name.value.clone());
     }
-    Ok((materials, names))
+    Ok((materials, names, texs))
 }
 
-/// The material names of a scene, for looking up the ones shapes refer to.
-struct Names<'a>(&'a [String]);
+/// The names of a scene's materials or textures, for looking up the ones referred to.
+struct Names<'a>(&'a [String], &'static str);
 
 impl Names<'_> {
-    /// The index of the material `name` refers to.
+    /// The index of the entry `name` refers to.
     fn index(&self, name: &At<String>) -> Result<u32, Failure> {
         self.0
             .iter()
@@ -494,7 +634,8 @@ impl Names<'_> {
                 (
                     name.ordinal,
                     format!(
-                        "unknown material `{}`; the scene defines: {known}",
+                        "unknown {} `{}`; the scene defines: {known}",
+                        self.1,
                         crate::echo(&name.value)
                     ),
                 )
@@ -532,7 +673,11 @@ fn lights(desc: &SceneFile, prims: &mut Vec<Prim>) -> Result<Vec<Light>, Failure
                 });
                 for tri in quad_triangles(c0, eu, ev) {
                     prims.push(Prim {
-                        shape: Shape::Triangle { v: tri, n: None },
+                        shape: Shape::Triangle {
+                            v: tri,
+                            n: None,
+                            uv: None,
+                        },
                         velocity: DVec3::ZERO,
                         material: u32::MAX,
                         light: Some(index),
@@ -610,8 +755,12 @@ fn shapes(desc: &SceneFile, names: &Names<'_>, dir: &Path, prims: &mut Vec<Prim>
                 if eu.cross(ev).length() <= 0.0 {
                     return Err((edge_u.ordinal, "a Quad's edges are parallel (zero area)".into()));
                 }
-                for tri in quad_triangles(v(*corner), eu, ev) {
-                    push(Shape::Triangle { v: tri, n: None });
+                for (tri, uv) in quad_triangles(v(*corner), eu, ev).into_iter().zip(QUAD_UV) {
+                    push(Shape::Triangle {
+                        v: tri,
+                        n: None,
+                        uv: Some(uv),
+                    });
                 }
             }
             ShapeDesc::Mesh {
@@ -624,10 +773,11 @@ fn shapes(desc: &SceneFile, names: &Names<'_>, dir: &Path, prims: &mut Vec<Prim>
                     .map_err(|e| (obj.ordinal, format!("OBJ `{}`: {e}", crate::echo(&obj.value))))?;
                 triangles += tris.len();
                 let (t, sc) = (translate.map_or(DVec3::ZERO, v), scale.map_or(1.0, |s| s.0));
-                for (p, n) in tris {
+                for (p, n, uv) in tris {
                     push(Shape::Triangle {
                         v: p.map(|q| q * sc + t),
                         n,
+                        uv,
                     });
                 }
             }
@@ -640,9 +790,17 @@ fn quad_triangles(c: DVec3, eu: DVec3, ev: DVec3) -> [[DVec3; 3]; 2] {
     [[c, c + eu, c + eu + ev], [c, c + eu + ev, c + ev]]
 }
 
-type ObjTriangle = ([DVec3; 3], Option<[DVec3; 3]>);
+/// The texture coordinates of [`quad_triangles`]' vertices: `u` along `edge_u`, `v` along
+/// `edge_v`, 0 to 1.
+const QUAD_UV: [[DVec2; 3]; 2] = [
+    [DVec2::new(0.0, 0.0), DVec2::new(1.0, 0.0), DVec2::new(1.0, 1.0)],
+    [DVec2::new(0.0, 0.0), DVec2::new(1.0, 1.0), DVec2::new(0.0, 1.0)],
+];
 
-/// Triangles (and vertex normals when the file has them) of an OBJ file, at most `limit`.
+type ObjTriangle = ([DVec3; 3], Option<[DVec3; 3]>, Option<[DVec2; 3]>);
+
+/// Triangles (with vertex normals and texture coordinates when the file has them) of an
+/// OBJ file, at most `limit`.
 fn load_obj(path: &Path, limit: usize) -> Result<Vec<ObjTriangle>, String> {
     if !path.is_file() {
         return Err(format!(
@@ -692,7 +850,21 @@ fn load_obj(path: &Path, limit: usize) -> Result<Vec<ObjTriangle>, String> {
                     _ => None,
                 }
             };
-            out.push((p, n));
+            let uv = if mesh.texcoords.is_empty() {
+                None
+            } else {
+                let t = |i: u32| -> Option<DVec2> {
+                    let i = 2 * i as usize;
+                    let a = mesh.texcoords.get(i..i + 2)?;
+                    let c = DVec2::new(a[0] as f64, a[1] as f64);
+                    c.is_finite().then_some(c)
+                };
+                match (t(f[0]), t(f[1]), t(f[2])) {
+                    (Some(a), Some(b), Some(c)) => Some([a, b, c]),
+                    _ => None,
+                }
+            };
+            out.push((p, n, uv));
         }
     }
     if out.is_empty() {

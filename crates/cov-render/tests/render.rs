@@ -148,7 +148,7 @@ fn the_covariance_pass_weights_estimate_the_radiance() {
     let (mut sum, mut sum2) = (0.0, 0.0);
     for _ in 0..m {
         let (px, py, ut) = (rng.random::<f64>(), rng.random::<f64>(), rng.random::<f64>());
-        let (rates, w) = trace_path(&world, &cc, px, py, ut, &mut rng)
+        let (rates, w) = trace_path(&world, &cc, (px, py), [0.0, 0.0, 1.0, 1.0], ut, &mut rng)
             .unwrap()
             .expect("the plane is seen");
         assert!(rates.samples_per_pixel.is_finite() && rates.image_cov_px[0][0] >= 0.0);
