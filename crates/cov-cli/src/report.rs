@@ -9,7 +9,7 @@ use std::time::Instant;
 use cov_validate::{Field, Grid, Primal, compare};
 use covtrace::brdf::{Brdf, Lobe, Reflect};
 use covtrace::curvature::Curvature;
-use covtrace::occlusion::{BlockerEdge, Window};
+use covtrace::occlusion::{BlockerEdge, Texture, Window};
 use covtrace::refraction::Refract;
 use covtrace::travel::Travel;
 use covtrace::{Chain, Cov};
@@ -125,7 +125,73 @@ pub fn cases() -> Result<Vec<Case>, covtrace::CovError> {
                 nodes: 2001,
             }),
         },
+        Case {
+            name: "sinusoidal texture",
+            gaussian: true,
+            chain: Chain::new().with(sinusoid_texture()?),
+            field: f0().then(Primal::Window(Arc::new(|z: &[f64]| {
+                1.0 + TEX_AMP * (TAU * TEX_FREQ * z[0]).cos()
+            }))),
+        },
+        Case {
+            name: "Gaussian-noise texture",
+            gaussian: false,
+            chain: Chain::new().with(noise_texture()?),
+            field: f0().then(Primal::Window(Arc::new(|z: &[f64]| {
+                1.0 + noise_terms()
+                    .iter()
+                    .map(|&(a, f, ph)| a * (TAU * f * z[0] + ph).cos())
+                    .sum::<f64>()
+            }))),
+        },
     ])
+}
+
+use std::f64::consts::TAU;
+
+/// The sinusoidal texture `1 + a cos(2π f x)`: amplitude and frequency (cycles/m).
+const TEX_AMP: f64 = 0.5;
+const TEX_FREQ: f64 = 2.0;
+
+/// The texture operator of the sinusoid, from its moments (`⟨A⟩ = 1`, `⟨A²⟩ = 1 + a²/2`,
+/// `⟨A'²⟩ = a² (2π f)² / 2`): in covtrace's amplitude convention the window's spectrum of
+/// a sinusoid on a constant is exactly `a f² / (1 + a)`, and all spectra involved are
+/// positive, so rule 2 is exact here.
+fn sinusoid_texture() -> Result<Texture, covtrace::CovError> {
+    let a = TEX_AMP;
+    Texture::from_moments(
+        1.0,
+        1.0 + a * a / 2.0,
+        [a * a * (TAU * TEX_FREQ).powi(2) / 2.0, 0.0, 0.0],
+    )
+}
+
+/// Smooth Gaussian noise as a sum of 16 cosines: amplitudes 0.08, frequencies drawn from a
+/// normal of std 2 cycles/m, phases uniform (a fixed SplitMix64 stream).
+fn noise_terms() -> Vec<(f64, f64, f64)> {
+    let mut state = 0x9E37_79B9_7F4A_7C15u64;
+    let mut next = move || {
+        state = state.wrapping_add(0x9E37_79B9_7F4A_7C15);
+        let mut z = state;
+        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+        ((z ^ (z >> 31)) >> 11) as f64 / (1u64 << 53) as f64
+    };
+    (0..16)
+        .map(|_| {
+            let (u1, u2) = (next().max(1e-12), next());
+            let f = 2.0 * (-2.0 * u1.ln()).sqrt() * (TAU * u2).cos();
+            (0.08, f.abs(), TAU * next())
+        })
+        .collect()
+}
+
+/// The texture operator of the noise, from its moments over the ensemble of phases.
+fn noise_texture() -> Result<Texture, covtrace::CovError> {
+    let t = noise_terms();
+    let p: f64 = t.iter().map(|&(a, _, _)| a * a / 2.0).sum();
+    let g: f64 = t.iter().map(|&(a, f, _)| a * a * (TAU * f).powi(2) / 2.0).sum();
+    Texture::from_moments(1.0, 1.0 + p, [g, 0.0, 0.0])
 }
 
 /// Grid sizes of the report: 32 to 256, and 512 with `full`.

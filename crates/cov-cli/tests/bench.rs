@@ -3,6 +3,7 @@
 
 mod common;
 use common::covtrace;
+use cov_render::renderer::Method;
 
 #[test]
 fn a_tiny_bench_writes_every_output_and_caches_its_reference() {
@@ -39,7 +40,7 @@ fn a_tiny_bench_writes_every_output_and_caches_its_reference() {
     }
     let csv = std::fs::read_to_string(dir.join("results.csv")).unwrap();
     let rows: Vec<&str> = csv.lines().skip(1).collect();
-    assert_eq!(rows.len(), 2 * 6, "{csv}");
+    assert_eq!(rows.len(), 2 * Method::ALL.len(), "{csv}");
     for r in &rows {
         let cells: Vec<&str> = r.split(',').collect();
         for c in &cells[1..10] {
@@ -49,7 +50,7 @@ fn a_tiny_bench_writes_every_output_and_caches_its_reference() {
     }
     let json: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(dir.join("results.json")).unwrap()).unwrap();
-    assert_eq!(json["runs"].as_array().map(Vec::len), Some(12));
+    assert_eq!(json["runs"].as_array().map(Vec::len), Some(2 * Method::ALL.len()));
     assert!(
         !stdout.contains("NaN") && !stdout.contains("(cached)"),
         "{stdout}"

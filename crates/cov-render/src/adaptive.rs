@@ -5,8 +5,9 @@
 //! the samples per pixel it needs over pixel × lens × time ([`crate::covpass`]). This
 //! module turns those predictions into decisions: [`allocate`] distributes a budget in
 //! proportion to a density, [`Guide`] holds each pixel's matched Gaussian (the filter
-//! whose spectrum matches the predicted content, [`filter_cov`]), and [`adapted_filters`]
-//! scales each matched filter by the noise of the samples that pixel actually received.
+//! whose spectrum matches the predicted content, [`filter_cov`]), and [`edge_clamp`] keeps
+//! wide filters off the edges the pass saw; the `guard` module checks the filters against
+//! the samples.
 
 use std::time::Instant;
 
@@ -26,48 +27,71 @@ pub const PIXEL_FILTER: f64 = 0.5;
 /// An adaptive pixel takes at most this many times the average budget.
 pub const MAX_RATIO: f64 = 16.0;
 /// Distributes `total` samples over pixels in proportion to `weights`, each pixel
-/// getting between `lo` and `hi` (water-filling: the clamped pixels' share goes to the
-/// others). Non-finite or negative weights count as 0. Rounding carries the fractions
-/// along the pixels, so the counts sum to `total` within one sample per clamped run.
+/// getting between `lo` and `hi` ([`allocate_floors`] with the same floor everywhere).
 pub fn allocate(weights: &[f64], total: f64, lo: u32, hi: u32) -> Vec<u32> {
+    allocate_floors(weights, total, &vec![lo; weights.len()], hi, false)
+}
+
+/// Distributes `total` samples over pixels in proportion to `weights`, pixel `i` getting
+/// between `floors[i]` and `hi` (water-filling: the clamped pixels' share goes to the
+/// others). Non-finite or negative weights count as 0. With `pow2`, each count is
+/// rounded to a power of two (unless a floor or `hi` is not one); the rounding carries the
+/// difference along the pixels, so the counts sum to `total` within about one pixel's
+/// count.
+pub fn allocate_floors(weights: &[f64], total: f64, floors: &[u32], hi: u32, pow2: bool) -> Vec<u32> {
     let n = weights.len();
-    let (lo_f, hi_f) = (f64::from(lo), f64::from(hi.max(lo)));
+    let lo = |i: usize| f64::from(floors.get(i).copied().unwrap_or(0));
+    let hi_f = f64::from(hi);
     let w: Vec<f64> = weights
         .iter()
         .map(|&v| if v.is_finite() && v > 0.0 { v } else { 0.0 })
         .collect();
-    let total = total.clamp(lo_f * n as f64, hi_f * n as f64);
-    let sum = |scale: f64| -> f64 { w.iter().map(|&v| (v * scale).clamp(lo_f, hi_f)).sum() };
+    let least: f64 = (0..n).map(|i| lo(i).min(hi_f)).sum();
+    let total = total.clamp(least, hi_f * n as f64);
+    let sum = |scale: f64| -> f64 {
+        w.iter()
+            .enumerate()
+            .map(|(i, &v)| (v * scale).clamp(lo(i).min(hi_f), hi_f))
+            .sum()
+    };
     let wsum: f64 = w.iter().sum();
     let mut counts = Vec::with_capacity(n);
-    if wsum <= 0.0 {
-        let each = total / n.max(1) as f64;
-        let mut carry = 0.0;
-        for _ in 0..n {
-            let v = each + carry;
-            let c = v.floor();
-            carry = v - c;
-            counts.push(c as u32);
+    // Without weights, the floors and an equal share of the rest.
+    let (scale, flat) = if wsum <= 0.0 {
+        (0.0, (total - least) / n.max(1) as f64)
+    } else {
+        // The scale s with Σ clamp(s·wᵢ) = total, by bisection on a log scale.
+        let (mut a, mut b) = (1e-300f64, 1e300f64);
+        for _ in 0..200 {
+            let m = (a * b).sqrt();
+            if sum(m) < total {
+                a = m;
+            } else {
+                b = m;
+            }
+            if b / a < 1.0 + 1e-12 {
+                break;
+            }
         }
-        return counts;
-    }
-    // The scale s with Σ clamp(s·wᵢ) = total, by bisection on a log scale.
-    let (mut a, mut b) = (1e-300f64, 1e300f64);
-    for _ in 0..200 {
-        let m = (a * b).sqrt();
-        if sum(m) < total {
-            a = m;
-        } else {
-            b = m;
-        }
-        if b / a < 1.0 + 1e-12 {
-            break;
-        }
-    }
+        (b, 0.0)
+    };
     let mut carry = 0.0;
-    for &v in &w {
-        let x = (v * b).clamp(lo_f, hi_f) + carry;
-        let c = x.floor().clamp(lo_f, hi_f);
+    for (i, &v) in w.iter().enumerate() {
+        let (l, top) = (lo(i).min(hi_f), hi_f);
+        let x = if wsum <= 0.0 {
+            l + flat
+        } else {
+            (v * scale).clamp(l, top)
+        } + carry;
+        // A power of two (the nearer in proportion; the difference is carried to the next
+        // pixel): a prefix of a pixel's Sobol sequence is a (t, m, s)-net only at powers of
+        // two, and a count in between can give a larger error than the power below it.
+        let c = if pow2 && x >= 1.0 {
+            let a = 2f64.powi(x.log2().floor() as i32);
+            if x >= 1.5 * a { 2.0 * a } else { a }.clamp(l, top).floor()
+        } else {
+            x.floor().clamp(l, top)
+        };
         carry = x - c;
         counts.push(c as u32);
     }
@@ -130,65 +154,6 @@ pub fn edge_clamp(width: u32, height: u32, raw: &[Gaussian]) -> Vec<Gaussian> {
             }
         })
         .collect()
-}
-
-/// The largest scale `k²` of a pixel's matched filter `F₀` ([`filter_cov`]): `k = 1` is
-/// the Gaussian whose spectrum matches the content's, where the model's relative bias is
-/// already `1 − 1/(1 + k²)` = 50%.
-pub const K2_MAX: f64 = 1.0;
-
-/// The share `m²` of a pixel's squared signal that its local spectrum's detail carries,
-/// in the bias term of [`adapted_filters`]. Σ gives the spread of the local spectrum, not
-/// how much of the signal lies away from its mean; `m² = 1` (all of it) is the pessimistic
-/// bound. 0.1 was chosen on the bundled Cornell scene at 256×192 from {1, 0.1, 0.01,
-/// 0.001} (relMSE at 2 to 64 spp; 0.01 is within 10% of it, 1 and 0.001 are 20–130% worse),
-/// and is kept for every scene.
-pub const MODULATION: f64 = 0.1;
-
-/// Each pixel's filter for the samples in `film`: its matched filter `F₀` scaled by the
-/// `k²` that minimises the predicted squared error
-///
-/// ```text
-/// MSE(k) = m² k⁴ I² + v / (4π n k² √det F₀)
-/// ```
-///
-/// (the bias of a filter `k² F₀` on a Gaussian spectrum is `1 − 1/(1 + k²) ≈ k²` of the
-/// detail `m I` ([`MODULATION`]); the noise of `n` samples of variance `v` averaged by a
-/// normalised Gaussian of covariance `k² F₀` px² is `v / (4π n k² √det F₀)`), so
-/// `k⁶ = v / (8π m² n (I² + ε) √det F₀)`, capped at [`K2_MAX`]. `v` is the 3×3 mean of the pixels' sample variances (from the
-/// spread of the 3×3 pixel means where pixels hold one sample), `I` the 3×3 largest
-/// luminance; then [`edge_clamp`]. More samples or less noise give narrower filters.
-pub fn adapted_filters(guide: &Guide, film: &Film) -> Vec<Gaussian> {
-    use rayon::prelude::*;
-    let (w, h) = (i64::from(film.width), i64::from(film.height));
-    let var = film.variance();
-    let img = film.box_image();
-    let lum: Vec<f64> = img.pixels.iter().map(|p| luminance(*p)).collect();
-    let raw: Vec<Gaussian> = (0..w * h)
-        .into_par_iter()
-        .map(|i| {
-            let (mut v, mut imax, mut m1, mut m2, mut k) = (0.0, 0.0f64, 0.0, 0.0, 0.0);
-            for (j, _) in around(w, h, i, 1) {
-                v += var[j];
-                imax = imax.max(lum[j]);
-                m1 += lum[j];
-                m2 += lum[j] * lum[j];
-                k += 1.0;
-            }
-            let n = f64::from(film.count[i as usize].max(1));
-            let v = if film.count[i as usize] >= 2 {
-                v / k
-            } else {
-                n * ((m2 - m1 * m1 / k) / (k - 1.0).max(1.0)).max(0.0)
-            };
-            let f0 = guide.matched[i as usize];
-            let det = (f0[0] * f0[2] - f0[1] * f0[1]).max(1e-12);
-            let k6 = v / (8.0 * std::f64::consts::PI * n * (imax * imax + REL_EPS) * det.sqrt());
-            let k2 = (k6 / MODULATION).cbrt().min(K2_MAX);
-            Gaussian::from_cov([f0[0] * k2, f0[1] * k2, f0[2] * k2])
-        })
-        .collect();
-    edge_clamp(film.width, film.height, &raw)
 }
 
 /// The covariance pass's products a method uses: sample weights and matched filters.
@@ -315,5 +280,14 @@ mod tests {
         assert_eq!(c[3], 34);
         // All zero: uniform.
         assert_eq!(allocate(&[0.0; 4], 10.0, 0, 100).iter().sum::<u32>(), 10);
+        // Powers of two, per-pixel floors, the total kept within a pixel's count.
+        let w: Vec<f64> = (0..64).map(|i| 1.0 + f64::from(i % 7)).collect();
+        let mut floors = vec![4; 64];
+        floors[0] = 16;
+        let c = allocate_floors(&w, 64.0 * 16.0, &floors, 256, true);
+        assert!(c.iter().all(|&v| v.is_power_of_two() && v >= 4), "{c:?}");
+        assert!(c[0] >= 16);
+        let sum: u32 = c.iter().sum();
+        assert!(sum.abs_diff(1024) <= 64, "{sum}");
     }
 }

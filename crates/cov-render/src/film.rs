@@ -146,6 +146,12 @@ impl Gaussian {
         Gaussian::from_cov([s * s, 0.0, s * s])
     }
 
+    /// The weight it gives a pixel's own samples in that pixel (its value at the origin,
+    /// `1 / (2π √det C)`).
+    pub fn peak(&self) -> f64 {
+        self.norm
+    }
+
     /// The larger std (px).
     pub fn std_max(&self) -> f64 {
         self.std_max
@@ -343,6 +349,21 @@ impl Film {
         if matches!(filter, Filter::Box) {
             return self.box_image();
         }
+        let acc = self.splat(filter);
+        let mut img = self.box_image();
+        for (i, p) in img.pixels.iter_mut().enumerate() {
+            let (s, wsum) = acc[i];
+            if wsum > 0.0 && self.count[i] > 0 {
+                *p = self.emitted[i] / f64::from(self.count[i]) + s / wsum;
+            }
+        }
+        img
+    }
+
+    /// Per pixel, the reflected radiance splatted into it with `filter` and the splatted
+    /// sample count (the two sums whose ratio [`Film::image`] takes); zero for
+    /// [`Filter::Box`] pixels, which splat nothing.
+    pub fn splat(&self, filter: &Filter) -> Vec<(DVec3, f64)> {
         let (w, h) = (self.width as usize, self.height as usize);
         // Each band of rows splats into a buffer with a margin as deep as its filters reach.
         let bands: Vec<(usize, Vec<(DVec3, f64)>)> = (0..h.div_ceil(BAND))
@@ -386,14 +407,7 @@ impl Film {
                 e.1 += v.1;
             }
         }
-        let mut img = self.box_image();
-        for (i, p) in img.pixels.iter_mut().enumerate() {
-            let (s, wsum) = acc[i];
-            if wsum > 0.0 && self.count[i] > 0 {
-                *p = self.emitted[i] / f64::from(self.count[i]) + s / wsum;
-            }
-        }
-        img
+        acc
     }
 
     /// Per pixel, the sample variance of the luminance of its own samples (0 with fewer

@@ -33,6 +33,7 @@
 //! | [`film`] | where samples land (tiles, per-pixel sums) and how they become pixels |
 //! | [`covpass`] | the covariance pass: operator chains per path, the per-pixel maps |
 //! | [`adaptive`] | sample allocation and per-pixel filters from the maps |
+//! | [`guard`] | the samples check the maps' filters, pixel by pixel |
 //! | [`renderer`] | one renderer for every method: [`Renderer`], [`RenderSettings`] |
 //! | [`denoise`] | Intel Open Image Denoise after reconstruction (feature `oidn`) |
 //! | [`metrics`], [`mod@bench`] | image error against a reference; error against time |
@@ -49,6 +50,7 @@ pub mod denoise;
 mod error;
 pub mod film;
 pub mod geometry;
+pub mod guard;
 pub mod material;
 pub mod metrics;
 pub mod output;

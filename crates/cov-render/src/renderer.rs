@@ -36,11 +36,14 @@
 
 use std::time::Instant;
 
+use glam::DVec3;
+
 use crate::RenderError;
-use crate::adaptive::{Guide, MAX_RATIO, adapted_filters, allocate, filter_area, relative_variance};
+use crate::adaptive::{Guide, MAX_RATIO, allocate, allocate_floors, filter_area, relative_variance};
 use crate::covpass::{CovMaps, MAX_COV_PATHS, STRIDES, covariance_maps};
 use crate::denoise::Denoise;
 use crate::film::{Film, Filter, Gaussian, Image, MAX_SPP, Progress};
+use crate::guard::{candidate, guarded};
 use crate::world::World;
 
 /// Std of the fixed Gaussian filter of the `gauss` baseline (px).
@@ -59,24 +62,35 @@ pub enum Method {
     Variance,
     /// Samples ∝ the covariance density, box filter (ablation).
     CovDensity,
-    /// Uniform samples, the covariance filter (ablation).
+    /// Uniform samples, the covariance filter without the guard (ablation).
     CovFilter,
-    /// Covariance tracing: a pilot, then samples ∝ the pilot's relative standard
-    /// deviation over the square root of the pixels the covariance filter averages, and
-    /// the covariance filter.
+    /// Covariance tracing without the guard (ablation): a pilot, then samples ∝ the
+    /// pilot's relative standard deviation over the square root of the pixels the matched
+    /// filter averages, and the matched filters.
+    CovUnguarded,
+    /// Covariance tracing: a pilot; the guard ([`crate::guard`]) checks the covariance
+    /// filters against the pilot's samples; samples ∝ the relative standard deviation
+    /// over the square root of the pixels the guarded filter averages; the guarded
+    /// reconstruction.
     Cov,
 }
 
 impl Method {
     /// Every method, baselines first.
-    pub const ALL: [Method; 6] = [
+    pub const ALL: [Method; 7] = [
         Method::Uniform,
         Method::Gauss,
         Method::Variance,
         Method::CovDensity,
         Method::CovFilter,
+        Method::CovUnguarded,
         Method::Cov,
     ];
+
+    /// Whether it takes a pilot pass and allocates the rest from it.
+    pub fn has_pilot(self) -> bool {
+        matches!(self, Method::Variance | Method::CovUnguarded | Method::Cov)
+    }
 
     /// Its name in tables and on the command line.
     pub fn name(self) -> &'static str {
@@ -86,6 +100,7 @@ impl Method {
             Method::Variance => "variance",
             Method::CovDensity => "cov-density",
             Method::CovFilter => "cov-filter",
+            Method::CovUnguarded => "cov-unguarded",
             Method::Cov => "cov",
         }
     }
@@ -117,7 +132,10 @@ impl Method {
 
     /// Whether it needs the covariance pass.
     pub fn uses_covariance(self) -> bool {
-        matches!(self, Method::CovDensity | Method::CovFilter | Method::Cov)
+        matches!(
+            self,
+            Method::CovDensity | Method::CovFilter | Method::CovUnguarded | Method::Cov
+        )
     }
 }
 
@@ -309,8 +327,7 @@ impl<'w> Renderer<'w> {
         let tiles = crate::film::tile_count(self.world);
         let s = &self.settings;
         let cov = usize::from(s.method.uses_covariance() && self.guide.is_none());
-        let passes = if matches!(s.method, Method::Variance | Method::Cov) && variance_pilot(s.spp).is_some()
-        {
+        let passes = if s.method.has_pilot() && variance_pilot(s.spp).is_some() {
             2
         } else {
             1
@@ -366,28 +383,48 @@ impl<'w> Renderer<'w> {
             }
             _ => allocate(&vec![1.0; n], total, 1, MAX_SPP),
         });
-        // The weights of the allocation after a pilot: the relative standard deviation
-        // (blurred over 3×3 pixels); for covariance tracing, over the square root of the
-        // number of pixels its matched filter averages (`filter_area`). Counts ∝ these
-        // weights minimise the summed relative error Σ σᵢ²/(nᵢ Aᵢ (μᵢ² + ε)) of pixels
-        // whose noise a filter averages over Aᵢ pixels, for a fixed total.
-        let weights = |film: &Film| -> Vec<f64> {
+        // The allocation after a pilot, per pixel: a weight and a floor. The weight is the
+        // relative standard deviation (blurred over 3×3 pixels); for covariance tracing,
+        // over the square root of the number of pixels its filter averages (`filter_area`:
+        // the matched filter, or the one the guard chose on the samples so far). Counts ∝
+        // these weights minimise the summed relative error Σ σᵢ²/(nᵢ Aᵢ (μᵢ² + ε)) of
+        // pixels whose noise a filter averages over Aᵢ pixels, for a fixed total. The
+        // guarded method also keeps, in every pixel whose samples the guard would not
+        // filter, at least the budget: sample variances overstate the error of
+        // quasi-Monte Carlo means where the integrand is smooth, so a pixel that no filter
+        // helps never gets fewer samples than plain Monte Carlo gives it.
+        let plan = |film: &Film, lo: u32| -> (Vec<f64>, Vec<u32>) {
             let rv = relative_variance(film);
-            match guide {
-                Some(g) if method == Method::Cov => rv
-                    .iter()
-                    .zip(&g.matched)
-                    .map(|(r, f)| r / filter_area(*f).sqrt())
-                    .collect(),
-                _ => rv,
+            match (method, guide) {
+                (Method::CovUnguarded, Some(g)) => (
+                    rv.iter()
+                        .zip(&g.matched)
+                        .map(|(r, f)| r / filter_area(*f).sqrt())
+                        .collect(),
+                    vec![lo; n],
+                ),
+                (Method::Cov, Some(g)) => {
+                    let gd = guarded(g, film, s.spp);
+                    let keep = (s.spp.floor() as u32).max(lo);
+                    gd.filters
+                        .iter()
+                        .zip(&rv)
+                        .map(|(f, r)| match f {
+                            Some(f) => (r / filter_area(f.cov()).sqrt(), lo),
+                            None => (*r, keep),
+                        })
+                        .unzip()
+                }
+                _ => (rv, vec![lo; n]),
             }
         };
         match method {
-            Method::Variance | Method::Cov => {
+            m if m.has_pilot() => {
                 if let Some(p) = variance_pilot(s.spp) {
                     sample(&mut film, &vec![p; n], &mut timing);
                     let (rest, secs) = timed(|| {
-                        allocate(&weights(&film), total, p, hi.max(p))
+                        let (wts, floors) = plan(&film, p);
+                        allocate_floors(&wts, total, &floors, hi.max(p), true)
                             .into_iter()
                             .map(|c| c.saturating_sub(p))
                             .collect::<Vec<u32>>()
@@ -415,8 +452,11 @@ impl<'w> Renderer<'w> {
                 if elapsed + pass_secs > limit || u64::from(highest) + u64::from(hi) > u64::from(MAX_SPP) {
                     break;
                 }
-                if matches!(method, Method::Variance | Method::Cov) {
-                    let (c, secs) = timed(|| allocate(&weights(&film), total, 1, hi));
+                if method.has_pilot() {
+                    let (c, secs) = timed(|| {
+                        let (wts, floors) = plan(&film, 1);
+                        allocate_floors(&wts, total, &floors, hi, true)
+                    });
                     timing.allocation += secs;
                     counts = c;
                 }
@@ -424,13 +464,31 @@ impl<'w> Renderer<'w> {
                 passes += 1;
             }
         }
-        let (image, secs) = timed(|| {
-            let filter = match (method, guide) {
-                (Method::Gauss, _) => Filter::Fixed(Gaussian::isotropic(FIXED_STD)),
-                (Method::CovFilter | Method::Cov, Some(g)) => Filter::PerPixel(adapted_filters(g, &film)),
-                _ => Filter::Box,
-            };
-            film.image(&filter)
+        let (image, secs) = timed(|| match (method, guide) {
+            (Method::Cov, Some(g)) => {
+                let gd = guarded(g, &film, 0.0);
+                let pixels = (0..n)
+                    .map(|i| match film.count[i] {
+                        0 => DVec3::ZERO,
+                        c => film.emitted[i] / f64::from(c) + gd.reflected[i],
+                    })
+                    .collect();
+                Image {
+                    width: w,
+                    height: h,
+                    pixels,
+                }
+            }
+            _ => {
+                let filter = match (method, guide) {
+                    (Method::Gauss, _) => Filter::Fixed(Gaussian::isotropic(FIXED_STD)),
+                    (Method::CovFilter | Method::CovUnguarded, Some(g)) => {
+                        Filter::PerPixel(candidate(g, 1.0))
+                    }
+                    _ => Filter::Box,
+                };
+                film.image(&filter)
+            }
         });
         timing.reconstruction += secs;
         let image = match s.denoise {

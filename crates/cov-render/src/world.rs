@@ -467,12 +467,13 @@ fn camera(c: &CameraDesc) -> Result<Camera, Failure> {
     })
 }
 
-/// A colour of a texture: a reflectance, at most 1 per channel.
-fn reflectance(c: Rgb, name: &At<String>) -> Result<DVec3, Failure> {
+/// A colour of the texture `name` (its description at `at`): a reflectance, at most 1 per
+/// channel.
+fn reflectance(c: Rgb, name: &At<String>, at: u32) -> Result<DVec3, Failure> {
     let c = DVec3::from_array(c.0);
     if c.max_element() > 1.0 {
         return Err((
-            name.ordinal,
+            at,
             format!(
                 "texture `{}`: a colour above 1 reflects more than it receives",
                 crate::echo(&name.value)
@@ -510,8 +511,8 @@ fn textures(desc: &SceneFile, dir: &Path) -> Result<(Vec<TextureMap>, Vec<String
                 repeat,
             } => TextureMap::checker(
                 *checks,
-                reflectance(*a, name)?,
-                reflectance(*b, name)?,
+                reflectance(*a, name, t.ordinal)?,
+                reflectance(*b, name, t.ordinal)?,
                 size(sz),
                 rep(repeat),
             )
@@ -526,8 +527,8 @@ fn textures(desc: &SceneFile, dir: &Path) -> Result<(Vec<TextureMap>, Vec<String
             } => TextureMap::stripes(
                 *count,
                 duty.map_or(0.5, |d| d.0),
-                reflectance(*a, name)?,
-                reflectance(*b, name)?,
+                reflectance(*a, name, t.ordinal)?,
+                reflectance(*b, name, t.ordinal)?,
                 size(sz),
                 rep(repeat),
             )
@@ -542,8 +543,8 @@ fn textures(desc: &SceneFile, dir: &Path) -> Result<(Vec<TextureMap>, Vec<String
             } => TextureMap::noise(
                 *cells,
                 seed.unwrap_or(0),
-                reflectance(*a, name)?,
-                reflectance(*b, name)?,
+                reflectance(*a, name, t.ordinal)?,
+                reflectance(*b, name, t.ordinal)?,
                 size(sz),
                 rep(repeat),
             )
@@ -555,11 +556,11 @@ fn textures(desc: &SceneFile, dir: &Path) -> Result<(Vec<TextureMap>, Vec<String
     Ok((maps, names))
 }
 
+/// Materials, their names, and their textures' indices.
+type Materials = (Vec<Material>, Vec<String>, Vec<Option<u32>>);
+
 /// The materials, their names and their textures, in the order of the file's map.
-fn materials(
-    desc: &SceneFile,
-    textures: &Names<'_>,
-) -> Result<(Vec<Material>, Vec<String>, Vec<Option<u32>>), Failure> {
+fn materials(desc: &SceneFile, textures: &Names<'_>) -> Result<Materials, Failure> {
     let mut materials = Vec::new();
     let mut names = Vec::new();
     let mut texs = Vec::new();

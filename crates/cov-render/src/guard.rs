@@ -1,0 +1,175 @@
+//! The guard: the samples check the covariance pass's prediction, pixel by pixel.
+//!
+//! A filter chosen from Σ alone is only as good as what the pass models: where it is blind
+//! (a texture it does not know, an inter-reflection it does not follow) the filter blurs
+//! real detail, and more samples do not remove that bias. The guard reconstructs the image
+//! with a family of filters, the matched filter `F₀` of every pixel scaled by each of
+//! [`SCALES`] (then kept off the edges the pass saw, [`crate::adaptive::edge_clamp`]), and
+//! the box; each pixel takes the candidate whose error, estimated from the samples
+//! themselves, is smallest.
+//!
+//! **The error estimate: leave-one-out cross-validation across pixels.** Each pixel's
+//! samples come from its own scrambled sequence, so different pixels' means `xⱼ` are
+//! independent. A candidate's estimate at pixel `p` mixes the pixel's own mean with the
+//! others': `ŷ = α x_p + (1 − α) ŷ₋ₚ`, where `α` is the share of `p`'s own samples in the
+//! filter's weight and `ŷ₋ₚ` the estimate without them. With `σ²` the variance of `x_p`,
+//!
+//! ```text
+//! E[(ŷ₋ₚ − x_p)²] = E[(ŷ₋ₚ − μ)²] + σ²        (independence)
+//! MSE(ŷ) = α² σ² + (1 − α)² E[(ŷ₋ₚ − μ)²]
+//!        ≈ α² σ² + (1 − α)² max((ŷ₋ₚ − x_p)² − σ², 0)
+//! MSE(box) = σ²
+//! ```
+//!
+//! The first line is what makes the check work: a filter that blurs detail the pass did
+//! not see predicts `x_p` badly from the neighbours, whatever Σ said. `σ²` is the sample
+//! variance of the pixel's luminance over its count; it overstates the variance of a
+//! quasi-Monte Carlo mean, which makes the box look worse than it is, so the guard leans
+//! towards filtering where it cannot tell. The estimates are relative (divided by the
+//! squared 3×3 mean luminance plus [`crate::metrics::REL_EPS`], the error the benchmarks
+//! report) and averaged over 3×3 pixels before each pixel picks the smallest: one pixel's
+//! squared residual is too noisy to decide alone (Stein's unbiased risk estimate, tried
+//! for the same choice, needs the variance of the estimate itself, which is as noisy).
+//!
+//! Its cost, one splat per candidate and 3×3 sums, counts in the reconstruction time.
+
+use glam::DVec3;
+use rayon::prelude::*;
+
+use crate::adaptive::{Guide, edge_clamp};
+use crate::film::{Film, Filter, Gaussian};
+use crate::metrics::REL_EPS;
+use crate::trace::luminance;
+
+/// The candidates' scales of each pixel's matched filter covariance `F₀` (a scale of 4
+/// doubles the std; 1/16 quarters it), widest first; the box is the last candidate.
+pub const SCALES: [f64; 3] = [1.0, 0.25, 0.0625];
+
+/// What the guard chose, per pixel.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Guarded {
+    /// The reflected radiance reconstructed with each pixel's chosen candidate (the box
+    /// mean for the box).
+    pub reflected: Vec<DVec3>,
+    /// The chosen candidate: an index into [`SCALES`], or `SCALES.len()` for the box.
+    pub choice: Vec<u8>,
+    /// The filter each pixel chose (`None`: the box).
+    pub filters: Vec<Option<Gaussian>>,
+}
+
+/// A candidate's filters, and its splatted sums per pixel ([`Film::splat`]).
+type Candidate = (Vec<Gaussian>, Vec<(DVec3, f64)>);
+
+/// The per-pixel filters of candidate `scale`: `scale · F₀`, kept off the pass's edges.
+pub fn candidate(guide: &Guide, scale: f64) -> Vec<Gaussian> {
+    let raw: Vec<Gaussian> = guide
+        .matched
+        .iter()
+        .map(|f| Gaussian::from_cov(f.map(|v| v * scale)))
+        .collect();
+    edge_clamp(guide.width, guide.height, &raw)
+}
+
+/// Reconstructs `film`'s reflected light with the guard (module docs). With `target`
+/// samples per pixel above a pixel's count (a pilot deciding where the rest of the budget
+/// goes), the choice is the one the guard would make at `target` samples: the variance
+/// terms shrink to `n/target` of the pilot's, while all of the cross-validation residual
+/// above the noise is taken for bias, which more samples do not remove (the conservative
+/// reading: a pilot's noise must not hide detail the full budget will show).
+pub fn guarded(guide: &Guide, film: &Film, target: f64) -> Guarded {
+    let (w, h) = (film.width as i64, film.height as i64);
+    let n = film.count.len();
+    let var = film.variance();
+    let x: Vec<DVec3> = (0..n)
+        .map(|i| match film.count[i] {
+            0 => DVec3::ZERO,
+            c => film.reflected[i] / f64::from(c),
+        })
+        .collect();
+    let lx: Vec<f64> = x.iter().map(|&v| luminance(v)).collect();
+    let s2: Vec<f64> = (0..n).map(|i| var[i] / f64::from(film.count[i].max(1))).collect();
+    // The variance of the pixel's mean at the target count.
+    let s2_target: Vec<f64> = (0..n)
+        .map(|i| {
+            let c = f64::from(film.count[i].max(1));
+            s2[i] * (c / target.max(c))
+        })
+        .collect();
+    // The normaliser of the relative error: the squared 3×3 mean luminance.
+    let norm: Vec<f64> = box3(w, h, &lx).iter().map(|m| m * m + REL_EPS).collect();
+    let mut risks: Vec<Vec<f64>> = Vec::with_capacity(SCALES.len() + 1);
+    let mut images: Vec<Candidate> = Vec::with_capacity(SCALES.len());
+    for &scale in &SCALES {
+        let filters = candidate(guide, scale);
+        let acc = film.splat(&Filter::PerPixel(filters.clone()));
+        let risk: Vec<f64> = (0..n)
+            .into_par_iter()
+            .map(|p| {
+                let c = f64::from(film.count[p]);
+                let (sum, wsum) = acc[p];
+                if c == 0.0 || wsum <= 0.0 {
+                    return f64::INFINITY;
+                }
+                let own = filters[p].peak();
+                let (loo_w, alpha) = (wsum - own * c, (own * c / wsum).clamp(0.0, 1.0));
+                // Below this share the others carry no weight: nothing to cross-validate.
+                if loo_w <= 1e-9 * wsum {
+                    return s2_target[p] / norm[p];
+                }
+                let loo = luminance(sum - film.reflected[p] * own) / loo_w;
+                let cv = (loo - lx[p]).powi(2);
+                (alpha * alpha * s2_target[p] + (1.0 - alpha).powi(2) * (cv - s2[p]).max(0.0)) / norm[p]
+            })
+            .collect();
+        risks.push(box3(w, h, &risk));
+        images.push((filters, acc));
+    }
+    risks.push(box3(
+        w,
+        h,
+        &(0..n).map(|p| s2_target[p] / norm[p]).collect::<Vec<_>>(),
+    ));
+    let choice: Vec<u8> = (0..n)
+        .map(|p| {
+            let mut best = SCALES.len();
+            for k in 0..SCALES.len() {
+                if risks[k][p] < risks[best][p] {
+                    best = k;
+                }
+            }
+            best as u8
+        })
+        .collect();
+    let reflected = (0..n)
+        .map(|p| match images.get(choice[p] as usize) {
+            Some((_, acc)) if acc[p].1 > 0.0 => acc[p].0 / acc[p].1,
+            _ => x[p],
+        })
+        .collect();
+    let filters = (0..n)
+        .map(|p| images.get(choice[p] as usize).map(|(f, _)| f[p]))
+        .collect();
+    Guarded {
+        reflected,
+        choice,
+        filters,
+    }
+}
+
+/// The 3×3 mean of `v` (fewer pixels at the borders; an infinite value stays infinite).
+fn box3(w: i64, h: i64, v: &[f64]) -> Vec<f64> {
+    (0..w * h)
+        .into_par_iter()
+        .map(|i| {
+            let (x, y) = (i % w, i / w);
+            let (mut s, mut k) = (0.0, 0.0);
+            for yy in (y - 1).max(0)..=(y + 1).min(h - 1) {
+                for xx in (x - 1).max(0)..=(x + 1).min(w - 1) {
+                    s += v[(yy * w + xx) as usize];
+                    k += 1.0;
+                }
+            }
+            s / k
+        })
+        .collect()
+}
