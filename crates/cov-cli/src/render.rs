@@ -17,9 +17,10 @@ use indicatif::{ProgressBar, ProgressStyle};
 pub struct RenderArgs {
     /// The scene file.
     pub scene: PathBuf,
-    /// Sampling and reconstruction method: cov (covariance tracing: samples where the
-    /// covariance pass predicts detail, per-pixel filters from Σ), cov-density,
-    /// cov-filter, variance, gauss or uniform (plain Monte Carlo).
+    /// Sampling and reconstruction method: cov (covariance tracing: per-pixel filters from
+    /// Σ, checked against the samples by the guard, and samples where they are needed),
+    /// cov-unguarded, cov-density, cov-filter (ablations), variance, gauss or uniform
+    /// (plain Monte Carlo).
     #[arg(long, default_value = "cov", value_parser = parse_method)]
     pub method: Method,
     /// Average samples per pixel (of each pass, with --time).

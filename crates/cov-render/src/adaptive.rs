@@ -127,22 +127,69 @@ fn around(w: i64, h: i64, i: i64, r: i64) -> impl Iterator<Item = (usize, i64)> 
     })
 }
 
+/// The pixels at Chebyshev distance `rho` ≥ 1 from `(x, y)` (unclipped).
+fn ring(x: i64, y: i64, rho: i64) -> impl Iterator<Item = (i64, i64)> {
+    let top = (-rho..=rho).map(move |d| (x + d, y - rho));
+    let bottom = (-rho..=rho).map(move |d| (x + d, y + rho));
+    let left = (1 - rho..rho).map(move |d| (x - rho, y + d));
+    let right = (1 - rho..rho).map(move |d| (x + rho, y + d));
+    top.chain(bottom).chain(left).chain(right)
+}
+
 /// Narrows every filter so that it does not reach, at [`EDGE_REACH`] of its own std, a
 /// pixel whose filter is narrower than the distance to it over [`EDGE_REACH`]: a wide
 /// filter stops short of an edge the covariance pass saw a few pixels away.
 pub fn edge_clamp(width: u32, height: u32, raw: &[Gaussian]) -> Vec<Gaussian> {
     use rayon::prelude::*;
     let (w, h) = (i64::from(width), i64::from(height));
+    // The smallest std within the farthest reach of any filter, by rows then columns: a
+    // pixel with no narrower filter in that square keeps its own (most pixels, and the
+    // widest filters, which would otherwise scan the most neighbours).
+    let stds: Vec<f64> = raw.iter().map(Gaussian::std_max).collect();
+    let reach = stds.iter().fold(0.0f64, |m, &s| m.max(s));
+    let reach = (EDGE_REACH * reach).ceil() as i64;
+    let window_min = |v: &[f64], along_rows: bool| -> Vec<f64> {
+        (0..w * h)
+            .into_par_iter()
+            .map(|i| {
+                let (x, y) = (i % w, i / w);
+                let (c, n) = if along_rows { (x, w) } else { (y, h) };
+                ((c - reach).max(0)..=(c + reach).min(n - 1))
+                    .map(|k| {
+                        if along_rows {
+                            v[(y * w + k) as usize]
+                        } else {
+                            v[(k * w + x) as usize]
+                        }
+                    })
+                    .fold(f64::INFINITY, f64::min)
+            })
+            .collect()
+    };
+    let near_min = window_min(&window_min(&stds, true), false);
     (0..w * h)
         .into_par_iter()
         .map(|i| {
             let g = raw[i as usize];
             let s = g.std_max();
+            if near_min[i as usize] >= s {
+                return g;
+            }
             let mut limit = s;
-            for (j, d2) in around(w, h, i, (EDGE_REACH * s).ceil() as i64) {
-                let sk = raw[j].std_max();
-                if sk < limit {
-                    limit = limit.min(sk.max((d2 as f64).sqrt() / EDGE_REACH));
+            // Rings of growing Chebyshev radius ρ: a pixel on ring ρ is at least ρ away, so
+            // it cannot bring the limit below ρ / EDGE_REACH; once that is the limit, stop.
+            let (x, y) = (i % w, i / w);
+            let r = (EDGE_REACH * s).ceil() as i64;
+            for rho in 1..=r {
+                if rho as f64 / EDGE_REACH >= limit {
+                    break;
+                }
+                for (xx, yy) in ring(x, y, rho).filter(|&(xx, yy)| xx >= 0 && yy >= 0 && xx < w && yy < h) {
+                    let sk = stds[(yy * w + xx) as usize];
+                    if sk < limit {
+                        let d = (((xx - x).pow(2) + (yy - y).pow(2)) as f64).sqrt();
+                        limit = limit.min(sk.max(d / EDGE_REACH));
+                    }
                 }
             }
             if limit < s {

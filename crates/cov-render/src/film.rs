@@ -99,6 +99,8 @@ pub struct Gaussian {
     norm: f64,
     /// Larger std (px).
     std_max: f64,
+    /// `exp(−precision_xx)`: the recurrence factor of [`Gaussian::splat_row`].
+    decay: f64,
 }
 
 impl Gaussian {
@@ -130,14 +132,12 @@ impl Gaussian {
         let (l1, l2) = (l1.clamp(lo, hi), l2.clamp(lo, hi));
         // Precision = V diag(1/l) Vᵀ with V = [[vx, -vy], [vy, vx]].
         let (i1, i2) = (1.0 / l1, 1.0 / l2);
+        let pxx = vx * vx * i1 + vy * vy * i2;
         Gaussian {
-            precision: [
-                vx * vx * i1 + vy * vy * i2,
-                vx * vy * (i1 - i2),
-                vy * vy * i1 + vx * vx * i2,
-            ],
+            precision: [pxx, vx * vy * (i1 - i2), vy * vy * i1 + vx * vx * i2],
             norm: 1.0 / (2.0 * std::f64::consts::PI * (l1 * l2).sqrt()),
             std_max: l1.max(l2).sqrt(),
+            decay: (-pxx).exp(),
         }
     }
 
@@ -167,7 +167,7 @@ impl Gaussian {
     /// Calls `add(cell, weight)` for the cells `x − r ..= x + r` of `row` (clipped to it) at
     /// vertical offset `dy`, with the weight at offset `(cell − x, dy)` where it is inside
     /// the [`CUTOFF`] ellipse. Walks outward from the row's peak with the Gaussian's
-    /// ratio recurrence (two products a cell, one `exp` per direction and row), so the
+    /// ratio recurrence (two products a cell, two `exp` a row), so the
     /// weights only decrease along a walk and underflow stops it, never skips a cell.
     pub fn splat_row<T>(&self, row: &mut [T], x: usize, dy: f64, r: usize, mut add: impl FnMut(&mut T, f64)) {
         let [p, q, rr] = self.precision;
@@ -179,10 +179,15 @@ impl Gaussian {
         let e_at = |dx: f64| p * dx * dx + 2.0 * q * dx * dy + rr * dy * dy;
         let c = ((-q * dy / p).round() as i64).clamp(lo, hi);
         let cut = CUTOFF * CUTOFF;
-        let decay = (-p).exp();
+        let decay = self.decay;
+        // w(c ± 1) / w(c) = exp(∓(½p(2c ± 1) + q dy)): with a = exp(½p(2c − 1) + q dy), the
+        // step right from c is decay / a and the step left from c is a (then each step
+        // multiplies by decay): two `exp` a row.
+        let a = (0.5 * p * (2 * c - 1) as f64 + q * dy).exp();
+        let w_c = self.norm * (-0.5 * e_at(c as f64)).exp();
         // Rightwards from the peak c.
-        let (mut e, mut wgt) = (e_at(c as f64), self.norm * (-0.5 * e_at(c as f64)).exp());
-        let mut ratio = (-0.5 * p * (2 * c + 1) as f64 - q * dy).exp();
+        let (mut e, mut wgt) = (e_at(c as f64), w_c);
+        let mut ratio = decay / a;
         for dx in c..=hi {
             if e > cut || wgt == 0.0 {
                 break;
@@ -195,8 +200,8 @@ impl Gaussian {
         // Leftwards from c − 1.
         if c > lo {
             let d = c - 1;
-            let (mut e, mut wgt) = (e_at(d as f64), self.norm * (-0.5 * e_at(d as f64)).exp());
-            let mut ratio = (0.5 * p * (2 * d - 1) as f64 + q * dy).exp();
+            let (mut e, mut wgt) = (e_at(d as f64), w_c * a);
+            let mut ratio = a * decay;
             for dx in (lo..=d).rev() {
                 if e > cut || wgt == 0.0 {
                     break;

@@ -51,14 +51,21 @@ pub struct Guarded {
     /// The reflected radiance reconstructed with each pixel's chosen candidate (the box
     /// mean for the box).
     pub reflected: Vec<DVec3>,
-    /// The chosen candidate: an index into [`SCALES`], or `SCALES.len()` for the box.
+    /// The chosen candidate: an index into the candidates ([`SCALES`]), or their number
+    /// for the box.
     pub choice: Vec<u8>,
     /// The filter each pixel chose (`None`: the box).
     pub filters: Vec<Option<Gaussian>>,
 }
 
 /// A candidate's filters, and its splatted sums per pixel ([`Film::splat`]).
-type Candidate = (Vec<Gaussian>, Vec<(DVec3, f64)>);
+type Candidate<'a> = (&'a [Gaussian], Vec<(DVec3, f64)>);
+
+/// The per-pixel filters of every candidate but the box, in the order of [`SCALES`]
+/// ([`candidate`]). They depend on the guide alone, so a render makes them once.
+pub fn candidates(guide: &Guide) -> Vec<Vec<Gaussian>> {
+    SCALES.iter().map(|&s| candidate(guide, s)).collect()
+}
 
 /// The per-pixel filters of candidate `scale`: `scale · F₀`, kept off the pass's edges.
 pub fn candidate(guide: &Guide, scale: f64) -> Vec<Gaussian> {
@@ -76,7 +83,9 @@ pub fn candidate(guide: &Guide, scale: f64) -> Vec<Gaussian> {
 /// terms shrink to `n/target` of the pilot's, while all of the cross-validation residual
 /// above the noise is taken for bias, which more samples do not remove (the conservative
 /// reading: a pilot's noise must not hide detail the full budget will show).
-pub fn guarded(guide: &Guide, film: &Film, target: f64) -> Guarded {
+///
+/// `candidates` are [`candidates`] of the film's guide.
+pub fn guarded(candidates: &[Vec<Gaussian>], film: &Film, target: f64) -> Guarded {
     let (w, h) = (film.width as i64, film.height as i64);
     let n = film.count.len();
     let var = film.variance();
@@ -97,10 +106,9 @@ pub fn guarded(guide: &Guide, film: &Film, target: f64) -> Guarded {
         .collect();
     // The normaliser of the relative error: the squared 3×3 mean luminance.
     let norm: Vec<f64> = box3(w, h, &lx).iter().map(|m| m * m + REL_EPS).collect();
-    let mut risks: Vec<Vec<f64>> = Vec::with_capacity(SCALES.len() + 1);
-    let mut images: Vec<Candidate> = Vec::with_capacity(SCALES.len());
-    for &scale in &SCALES {
-        let filters = candidate(guide, scale);
+    let mut risks: Vec<Vec<f64>> = Vec::with_capacity(candidates.len() + 1);
+    let mut images: Vec<Candidate<'_>> = Vec::with_capacity(candidates.len());
+    for filters in candidates {
         let acc = film.splat(&Filter::PerPixel(filters.clone()));
         let risk: Vec<f64> = (0..n)
             .into_par_iter()
@@ -122,7 +130,7 @@ pub fn guarded(guide: &Guide, film: &Film, target: f64) -> Guarded {
             })
             .collect();
         risks.push(box3(w, h, &risk));
-        images.push((filters, acc));
+        images.push((filters.as_slice(), acc));
     }
     risks.push(box3(
         w,

@@ -43,7 +43,7 @@ use crate::adaptive::{Guide, MAX_RATIO, allocate, allocate_floors, filter_area, 
 use crate::covpass::{CovMaps, MAX_COV_PATHS, STRIDES, covariance_maps};
 use crate::denoise::Denoise;
 use crate::film::{Film, Filter, Gaussian, Image, MAX_SPP, Progress};
-use crate::guard::{candidate, guarded};
+use crate::guard::{candidate, candidates, guarded};
 use crate::world::World;
 
 /// Std of the fixed Gaussian filter of the `gauss` baseline (px).
@@ -393,6 +393,12 @@ impl<'w> Renderer<'w> {
         // filter, at least the budget: sample variances overstate the error of
         // quasi-Monte Carlo means where the integrand is smooth, so a pixel that no filter
         // helps never gets fewer samples than plain Monte Carlo gives it.
+        // The guard's candidate filters, once per render (they depend on the guide alone).
+        let (cands, secs) = timed(|| match (method, guide) {
+            (Method::Cov, Some(g)) => candidates(g),
+            _ => Vec::new(),
+        });
+        timing.allocation += secs;
         let plan = |film: &Film, lo: u32| -> (Vec<f64>, Vec<u32>) {
             let rv = relative_variance(film);
             match (method, guide) {
@@ -403,8 +409,8 @@ impl<'w> Renderer<'w> {
                         .collect(),
                     vec![lo; n],
                 ),
-                (Method::Cov, Some(g)) => {
-                    let gd = guarded(g, film, s.spp);
+                (Method::Cov, Some(_)) => {
+                    let gd = guarded(&cands, film, s.spp);
                     let keep = (s.spp.floor() as u32).max(lo);
                     gd.filters
                         .iter()
@@ -465,8 +471,8 @@ impl<'w> Renderer<'w> {
             }
         }
         let (image, secs) = timed(|| match (method, guide) {
-            (Method::Cov, Some(g)) => {
-                let gd = guarded(g, &film, 0.0);
+            (Method::Cov, Some(_)) => {
+                let gd = guarded(&cands, &film, 0.0);
                 let pixels = (0..n)
                     .map(|i| match film.count[i] {
                         0 => DVec3::ZERO,

@@ -31,6 +31,37 @@ fn features_of_a_plane_seen_from_above_are_its_closed_form() {
     }
 }
 
+/// A textured plane seen straight down, filling the view: a 2×2 checker over 8×8 pixels.
+/// Pixels inside a square see only its colour, so their albedo is that colour exactly
+/// (the material's albedo 1 times the texture).
+#[test]
+fn the_albedo_of_a_textured_plane_is_its_texture() {
+    let h = 0.25f64.to_radians().tan();
+    let text = format!(
+        r#"Scene(
+        camera: (position: (0.0, 1.0, 0.0), look_at: (0.0, 0.0, 0.0), up: (0.0, 0.0, -1.0), fov: 0.5, width: 8, height: 8),
+        textures: {{ "c": Checker(checks: (2, 2), a: (0.8, 0.2, 0.1), b: (0.1, 0.3, 0.9), size: 512) }},
+        materials: {{ "t": Diffuse(albedo: (1.0, 1.0, 1.0), texture: "c") }},
+        lights: [Sphere(center: (0.0, 2.0, 0.0), radius: 0.5, radiance: (1.0, 1.0, 1.0))],
+        shapes: [Quad(corner: ({m:?}, 0.0, {m:?}), edge_u: ({w:?}, 0.0, 0.0), edge_v: (0.0, 0.0, {w:?}), material: "t")],
+    )"#,
+        m = -h,
+        w = 2.0 * h
+    );
+    let world = World::from_text(&text, "<test>", Path::new(".")).unwrap();
+    let mut film = Film::new(8, 8);
+    film.render(&world, &[16; 64], 1, f64::INFINITY, None);
+    let aovs = film.aovs();
+    let (a, b) = (glam::DVec3::new(0.8, 0.2, 0.1), glam::DVec3::new(0.1, 0.3, 0.9));
+    for (x, y, want) in [(1, 1, a), (6, 1, b), (1, 6, b), (6, 6, a), (2, 5, b), (5, 2, b)] {
+        let got = aovs.albedo.pixels[y * 8 + x];
+        assert!(
+            (got - want).abs().max_element() < 1e-5,
+            "pixel ({x}, {y}): {got} against {want}"
+        );
+    }
+}
+
 /// The multi-layer EXR holds the three layers with the film's values.
 #[test]
 fn the_feature_file_reads_back() {
