@@ -63,6 +63,24 @@ pub fn turn(d: DVec3, from: DVec3, to: DVec3) -> f64 {
     to.dot(y).atan2(to.dot(from))
 }
 
+/// Pushes `ops`, which act on an object moving at `velocity`, onto `chain`: inside
+/// `Moving` (in the frame `(x, d × x)` of the ray `d`) when the pass traces time and the
+/// object moves, as they are otherwise.
+fn push_on(
+    chain: &mut Chain,
+    motion: bool,
+    velocity: DVec3,
+    (d, x): (DVec3, DVec3),
+    ops: Chain,
+) -> Result<(), CovError> {
+    if motion && velocity != DVec3::ZERO {
+        chain.push(Moving::new(in_frame(velocity, d, x), [0.0, 0.0], ops)?);
+    } else {
+        chain.push(ops);
+    }
+    Ok(())
+}
+
 /// The tangential velocity `v` seen in the frame `(x, d × x)` of a ray `d`.
 fn in_frame(v: DVec3, d: DVec3, x: DVec3) -> [f64; 2] {
     [v.dot(x), v.dot(d.cross(x))]
@@ -294,15 +312,7 @@ pub fn trace_path<R: Rng>(
             if let Some(t) = texture_window(world, &hit, d_out, x_out, footprint)? {
                 at_surface.push(t);
             }
-            if motion && hit.velocity != DVec3::ZERO {
-                chain.push(Moving::new(
-                    in_frame(hit.velocity, d_out, x_out),
-                    [0.0, 0.0],
-                    at_surface,
-                )?);
-            } else {
-                chain.push(at_surface);
-            }
+            push_on(&mut chain, motion, hit.velocity, (d_out, x_out), at_surface)?;
         } else {
             // The light sample does not reach this side: what the camera sees here is
             // indirect light, taken as constant (Σ = 0) where it leaves the surface. The
@@ -310,15 +320,13 @@ pub fn trace_path<R: Rng>(
             weight = 0.0;
             start = AnyCov::zeros(cc.layout)?;
             if let Some(t) = texture_window(world, &hit, d_out, x_out, footprint)? {
-                if motion && hit.velocity != DVec3::ZERO {
-                    chain.push(Moving::new(
-                        in_frame(hit.velocity, d_out, x_out),
-                        [0.0, 0.0],
-                        Chain::new().with(t),
-                    )?);
-                } else {
-                    chain.push(t);
-                }
+                push_on(
+                    &mut chain,
+                    motion,
+                    hit.velocity,
+                    (d_out, x_out),
+                    Chain::new().with(t),
+                )?;
             }
         }
     }
@@ -327,16 +335,8 @@ pub fn trace_path<R: Rng>(
     match nearest_silhouette(world, &hit, (px, py), block, time, ut) {
         Some(e) => {
             chain.push(Travel::new((hit.t - e.depth).max(0.0))?);
-            let edge = BlockerEdge::new(e.radius)?;
-            if motion && e.velocity != DVec3::ZERO {
-                chain.push(Moving::new(
-                    in_frame(e.velocity, d_out, x_out),
-                    [0.0, 0.0],
-                    Chain::new().with(edge),
-                )?);
-            } else {
-                chain.push(edge);
-            }
+            let edge = Chain::new().with(BlockerEdge::new(e.radius)?);
+            push_on(&mut chain, motion, e.velocity, (d_out, x_out), edge)?;
             chain.push(Travel::new(e.depth.min(hit.t))?);
         }
         None => chain.push(Travel::new(hit.t)?),
