@@ -142,39 +142,12 @@ fn ring(x: i64, y: i64, rho: i64) -> impl Iterator<Item = (i64, i64)> {
 pub fn edge_clamp(width: u32, height: u32, raw: &[Gaussian]) -> Vec<Gaussian> {
     use rayon::prelude::*;
     let (w, h) = (i64::from(width), i64::from(height));
-    // The smallest std within the farthest reach of any filter, by rows then columns: a
-    // pixel with no narrower filter in that square keeps its own (most pixels, and the
-    // widest filters, which would otherwise scan the most neighbours).
     let stds: Vec<f64> = raw.iter().map(Gaussian::std_max).collect();
-    let reach = stds.iter().fold(0.0f64, |m, &s| m.max(s));
-    let reach = (EDGE_REACH * reach).ceil() as i64;
-    let window_min = |v: &[f64], along_rows: bool| -> Vec<f64> {
-        (0..w * h)
-            .into_par_iter()
-            .map(|i| {
-                let (x, y) = (i % w, i / w);
-                let (c, n) = if along_rows { (x, w) } else { (y, h) };
-                ((c - reach).max(0)..=(c + reach).min(n - 1))
-                    .map(|k| {
-                        if along_rows {
-                            v[(y * w + k) as usize]
-                        } else {
-                            v[(k * w + x) as usize]
-                        }
-                    })
-                    .fold(f64::INFINITY, f64::min)
-            })
-            .collect()
-    };
-    let near_min = window_min(&window_min(&stds, true), false);
     (0..w * h)
         .into_par_iter()
         .map(|i| {
             let g = raw[i as usize];
             let s = g.std_max();
-            if near_min[i as usize] >= s {
-                return g;
-            }
             let mut limit = s;
             // Rings of growing Chebyshev radius ρ: a pixel on ring ρ is at least ρ away, so
             // it cannot bring the limit below ρ / EDGE_REACH; once that is the limit, stop.

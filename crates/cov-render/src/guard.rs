@@ -51,9 +51,6 @@ pub struct Guarded {
     /// The reflected radiance reconstructed with each pixel's chosen candidate (the box
     /// mean for the box).
     pub reflected: Vec<DVec3>,
-    /// The chosen candidate: an index into the candidates ([`SCALES`]), or their number
-    /// for the box.
-    pub choice: Vec<u8>,
     /// The filter each pixel chose (`None`: the box).
     pub filters: Vec<Option<Gaussian>>,
 }
@@ -157,11 +154,7 @@ pub fn guarded(candidates: &[Vec<Gaussian>], film: &Film, target: f64) -> Guarde
     let filters = (0..n)
         .map(|p| images.get(choice[p] as usize).map(|(f, _)| f[p]))
         .collect();
-    Guarded {
-        reflected,
-        choice,
-        filters,
-    }
+    Guarded { reflected, filters }
 }
 
 /// The 3×3 mean of `v` (fewer pixels at the borders; an infinite value stays infinite).

@@ -55,6 +55,17 @@ fn lum(c: [f32; 3]) -> f64 {
     crate::material::luminance(DVec3::new(c[0] as f64, c[1] as f64, c[2] as f64))
 }
 
+/// Checks that a procedural texture's parameter `what` (a count of features across it)
+/// is 1 to its `size` in texels.
+fn per_texture(what: &str, v: u32, size: u32) -> Result<(), String> {
+    if v == 0 || v > size {
+        return Err(format!(
+            "{what} must be 1 to the texture's size ({size}), got {v}"
+        ));
+    }
+    Ok(())
+}
+
 impl TextureMap {
     /// A texture from linear RGB texels (row 0 at the top, rows of `w`), values clamped to
     /// `[0, 1]` (a reflectance; NaN becomes 0), repeated `repeat` times over a unit of `u`
@@ -128,11 +139,7 @@ impl TextureMap {
         size: u32,
         repeat: DVec2,
     ) -> Result<TextureMap, String> {
-        if count == 0 || count > size {
-            return Err(format!(
-                "count must be 1 to the texture's size ({size}), got {count}"
-            ));
-        }
+        per_texture("count", count, size)?;
         if !(duty > 0.0 && duty < 1.0) {
             return Err(format!("duty must be in (0, 1), got {duty}"));
         }
@@ -156,11 +163,7 @@ impl TextureMap {
         repeat: DVec2,
     ) -> Result<TextureMap, String> {
         use rand::{Rng, SeedableRng};
-        if cells == 0 || cells > size {
-            return Err(format!(
-                "cells must be 1 to the texture's size ({size}), got {cells}"
-            ));
-        }
+        per_texture("cells", cells, size)?;
         let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
         let n = cells as usize;
         let lattice: Vec<f64> = (0..n * n).map(|_| rng.random::<f64>()).collect();

@@ -495,28 +495,28 @@ fn textures(desc: &SceneFile, dir: &Path) -> Result<(Vec<TextureMap>, Vec<String
             r.map_or(DVec2::ONE, |(a, b)| DVec2::new(a.0, b.0))
         };
         let size = |s: &Option<u32>| s.unwrap_or(DEFAULT_TEXTURE_SIZE);
-        let map = match &t.value {
-            TextureDesc::Image { file, repeat } => TextureMap::load(&dir.join(&file.value), rep(repeat))
-                .map_err(|e| {
-                    (
-                        file.ordinal,
-                        format!("texture `{}`: {e}", crate::echo(&name.value)),
-                    )
-                })?,
+        // The map, and where an error in making it points (the file name, or the texture).
+        let (map, at) = match &t.value {
+            TextureDesc::Image { file, repeat } => (
+                TextureMap::load(&dir.join(&file.value), rep(repeat)),
+                file.ordinal,
+            ),
             TextureDesc::Checker {
                 checks,
                 a,
                 b,
                 size: sz,
                 repeat,
-            } => TextureMap::checker(
-                *checks,
-                reflectance(*a, name, t.ordinal)?,
-                reflectance(*b, name, t.ordinal)?,
-                size(sz),
-                rep(repeat),
-            )
-            .map_err(|e| (t.ordinal, format!("texture `{}`: {e}", crate::echo(&name.value))))?,
+            } => (
+                TextureMap::checker(
+                    *checks,
+                    reflectance(*a, name, t.ordinal)?,
+                    reflectance(*b, name, t.ordinal)?,
+                    size(sz),
+                    rep(repeat),
+                ),
+                t.ordinal,
+            ),
             TextureDesc::Stripes {
                 count,
                 duty,
@@ -524,15 +524,17 @@ fn textures(desc: &SceneFile, dir: &Path) -> Result<(Vec<TextureMap>, Vec<String
                 b,
                 size: sz,
                 repeat,
-            } => TextureMap::stripes(
-                *count,
-                duty.map_or(0.5, |d| d.0),
-                reflectance(*a, name, t.ordinal)?,
-                reflectance(*b, name, t.ordinal)?,
-                size(sz),
-                rep(repeat),
-            )
-            .map_err(|e| (t.ordinal, format!("texture `{}`: {e}", crate::echo(&name.value))))?,
+            } => (
+                TextureMap::stripes(
+                    *count,
+                    duty.map_or(0.5, |d| d.0),
+                    reflectance(*a, name, t.ordinal)?,
+                    reflectance(*b, name, t.ordinal)?,
+                    size(sz),
+                    rep(repeat),
+                ),
+                t.ordinal,
+            ),
             TextureDesc::Noise {
                 cells,
                 a,
@@ -540,16 +542,19 @@ fn textures(desc: &SceneFile, dir: &Path) -> Result<(Vec<TextureMap>, Vec<String
                 seed,
                 size: sz,
                 repeat,
-            } => TextureMap::noise(
-                *cells,
-                seed.unwrap_or(0),
-                reflectance(*a, name, t.ordinal)?,
-                reflectance(*b, name, t.ordinal)?,
-                size(sz),
-                rep(repeat),
-            )
-            .map_err(|e| (t.ordinal, format!("texture `{}`: {e}", crate::echo(&name.value))))?,
+            } => (
+                TextureMap::noise(
+                    *cells,
+                    seed.unwrap_or(0),
+                    reflectance(*a, name, t.ordinal)?,
+                    reflectance(*b, name, t.ordinal)?,
+                    size(sz),
+                    rep(repeat),
+                ),
+                t.ordinal,
+            ),
         };
+        let map = map.map_err(|e| (at, format!("texture `{}`: {e}", crate::echo(&name.value))))?;
         maps.push(map);
         names.push(name.value.clone());
     }
