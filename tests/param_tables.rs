@@ -66,3 +66,52 @@ fn every_parameter_is_documented_with_a_unit_or_a_reason_not_to() {
         }
     }
 }
+
+/// A parameter is named once, by its field: no operator crate spells a parameter's name
+/// in a string literal (errors name parameters through the spec's constants, `arg!` or
+/// the derive's generated checks), so a renamed field cannot leave a stale name behind.
+#[test]
+fn no_operator_crate_spells_a_parameter_name_in_a_string() {
+    let crates: [(&str, Register); 10] = [
+        ("cov-travel", covtrace::travel::spec::register),
+        ("cov-occlusion", covtrace::occlusion::spec::register),
+        ("cov-projection", covtrace::projection::spec::register),
+        ("cov-curvature", covtrace::curvature::spec::register),
+        ("cov-brdf", covtrace::brdf::spec::register),
+        ("cov-refraction", covtrace::refraction::spec::register),
+        ("cov-motion", covtrace::motion::spec::register),
+        ("cov-defocus", covtrace::defocus::spec::register),
+        ("cov-sensor", covtrace::sensor::spec::register),
+        ("cov-media", covtrace::media::spec::register),
+    ];
+    let mut found = Vec::new();
+    for (dir, register) in crates {
+        let mut c = Catalogue::default();
+        register(&mut c);
+        let names: Vec<&str> = c
+            .entries
+            .iter()
+            .flat_map(|e| e.params.iter().map(|p| p.name))
+            .collect();
+        let src = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join(format!("crates/{dir}/src"));
+        for entry in std::fs::read_dir(&src).expect("src dir") {
+            let path = entry.expect("entry").path();
+            let text = std::fs::read_to_string(&path).expect("source");
+            for (i, line) in text.lines().enumerate() {
+                let code = line.split("//").next().unwrap_or("");
+                // The string literals of the line (no escaped quotes in these crates'
+                // code lines).
+                for (k, lit) in code.split('"').enumerate() {
+                    if k % 2 == 1 && names.contains(&lit) {
+                        found.push(format!("{}:{}: \"{lit}\"", path.display(), i + 1));
+                    }
+                }
+            }
+        }
+    }
+    assert!(
+        found.is_empty(),
+        "parameter names typed as strings:\n{}",
+        found.join("\n")
+    );
+}

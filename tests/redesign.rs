@@ -3,7 +3,9 @@
 
 use covtrace::path::{Path, PathError};
 use covtrace::sensor::PixelDecisions;
-use covtrace::{AnyCov, Axis, Chain, Cov, CovError, Form, Operator, OperatorSpec, Registrar, Spectrum};
+use covtrace::{
+    AnyCov, Axis, Build, Chain, Checked, Cov, CovError, Form, Operator, OperatorSpec, Registrar, Spectrum,
+};
 
 fn parse(text: &str) -> Result<Path, PathError> {
     Path::parse(text, &covtrace::registry())
@@ -49,15 +51,15 @@ impl Operator for Blur {
 #[derive(Debug, OperatorSpec)]
 #[operator(summary = "a third-party blur")]
 struct BlurSpec {
-    /// Lobe spectrum, ≥ 0.
-    #[param(unit = "(cycles/tan)²", default = 4.0)]
+    /// Lobe spectrum.
+    #[param(unit = "(cycles/tan)²", default = 4.0, non_negative)]
     s: f64,
 }
 
-impl TryFrom<BlurSpec> for Blur {
-    type Error = CovError;
-    fn try_from(p: BlurSpec) -> Result<Blur, CovError> {
-        Ok(Blur(CovError::require_non_negative("Blur", "s", p.s)?))
+impl Build for BlurSpec {
+    type Op = Blur;
+    fn make(p: Checked<Self>) -> Result<Blur, CovError> {
+        Ok(Blur(p.s))
     }
 }
 

@@ -117,22 +117,25 @@ proptest! {
 
 #[test]
 fn turn_is_rotate_frame_and_names_its_parameter() {
-    for angle in [0.0, -0.0, 0.3, -2.5, 1e-300, 1e12, 1e300, 3.0e-8, 710.5] {
-        let t = Turn::new("Op", "angle", angle).expect("finite");
+    for angle in [0.0f64, -0.0, 0.3, -2.5, 1e-300, 1e12, 1e300, 3.0e-8, 710.5] {
+        let t = Turn::new(covtrace::arg!("Op", angle)).expect("finite");
         let (s, c) = angle.sin_cos();
         assert_eq!((t.sin().to_bits(), t.cos().to_bits()), (s.to_bits(), c.to_bits()));
         assert_eq!(t.angle().to_bits(), angle.to_bits());
         // The way back without trigonometry: `sin` odd to the bit.
-        let back = Turn::new("Op", "angle", -angle).expect("finite");
+        let minus = -angle;
+        let back = Turn::new(covtrace::arg!("Op", minus)).expect("finite");
         let inv = t.inverse();
         assert_eq!(
             (inv.sin().to_bits(), inv.cos().to_bits()),
             (back.sin().to_bits(), back.cos().to_bits())
         );
     }
-    assert_eq!(Turn::ZERO, Turn::new("Op", "angle", 0.0).expect("finite"));
-    for bad in [f64::NAN, f64::INFINITY, f64::NEG_INFINITY] {
-        let e = Turn::new("Scatter", "azimuth", bad)
+    let zero = 0.0;
+    assert_eq!(Turn::ZERO, Turn::new(covtrace::arg!("Op", zero)).expect("finite"));
+    for azimuth in [f64::NAN, f64::INFINITY, f64::NEG_INFINITY] {
+        let bad = azimuth;
+        let e = Turn::new(covtrace::arg!("Scatter", azimuth))
             .expect_err("non-finite")
             .to_string();
         assert!(e.contains("Scatter") && e.contains("azimuth"), "{e}");
@@ -146,7 +149,8 @@ fn turn_is_rotate_frame_and_names_its_parameter() {
     }
     // Flatland has no frame to turn: the same error as `rotate_frame`.
     let mut flat = Cov::<2>::from_diagonal([1.0, 2.0]).expect("valid");
-    let t = Turn::new("Op", "angle", 0.3).expect("finite");
+    let angle = 0.3;
+    let t = Turn::new(covtrace::arg!("Op", angle)).expect("finite");
     assert_eq!(
         flat.rotate_frame_by(t).map_err(|e| e.to_string()),
         flat.rotate_frame(0.3).map_err(|e| e.to_string())

@@ -18,14 +18,14 @@
 //! Parameters, as written in a path file (`covtrace list` prints the same):
 //!
 //! <!-- parameters: generated from the specs (`COVTRACE_BLESS=1 cargo test --test param_tables`) -->
-//! | operator | parameter | unit | default | meaning |
-//! |---|---|---|---|---|
-//! | `Brdf` | `lobe` | – | required | The lobe: `Diffuse`, `Mirror`, `Phong(exponent)`, `Gaussian(var_u, var_v)`, `Beckmann(alpha_u, alpha_v)` or `Ggx(alpha_u, alpha_v)`. |
-//! | `Reflect` | `cos_in` | – | required | `\|cos θ_in\|`, in (0, 1]. |
-//! |  | `cos_out` | – | required | `\|cos θ_out\|`, in (0, 1]. |
-//! |  | `curvature` | 1/m | optional | Surface curvature, `(k: …)` or `(kx: …, ky: …, angle: …)`; flat when left out. |
-//! |  | `lobe` | – | required | The lobe, as in `Brdf`. |
-//! |  | `turn` | rad | optional | Turn of the surface frame from the plane of incidence to the outgoing ray's (3D). |
+//! | operator | parameter | unit | default | domain | meaning |
+//! |---|---|---|---|---|---|
+//! | `Brdf` | `lobe` | – | required | – | The lobe: `Diffuse`, `Mirror`, `Phong(exponent)`, `Gaussian(var_u, var_v)`, `Beckmann(alpha_u, alpha_v)` or `Ggx(alpha_u, alpha_v)`. |
+//! | `Reflect` | `cos_in` | – | required | in (0, 1] | `\|cos θ_in\|`. |
+//! |  | `cos_out` | – | required | in (0, 1] | `\|cos θ_out\|`. |
+//! |  | `curvature` | 1/m | optional | – | Surface curvature, `(k: …)` or `(kx: …, ky: …, angle: …)`; flat when left out. |
+//! |  | `lobe` | – | required | – | The lobe, as in `Brdf`. |
+//! |  | `turn` | rad | optional | finite | Turn of the surface frame from the plane of incidence to the outgoing ray's (3D). |
 //! <!-- end of parameters -->
 //!
 //! Zero roughness is the mirror, exactly. Anisotropic roughness is along the frame's
@@ -88,8 +88,8 @@
 
 pub mod spec;
 
-use cov_core::{Axis, CovError, FOUR_PI_SQ, Operator, Spectrum, Turn};
-use cov_curvature::Curvature;
+use cov_core::{Axis, CovError, FOUR_PI_SQ, Operator, OperatorSpec, Spectrum, Turn, arg};
+use cov_curvature::{Curvature, spec::CurvatureSpec};
 use cov_projection::{Mirror, Project, Unproject};
 
 /// A reflectance (or transmittance) lobe over the outgoing direction. In RON:
@@ -136,8 +136,7 @@ impl Lobe {
     /// # Errors
     /// Negative or non-finite exponent.
     pub fn phong(exponent: f64) -> Result<Lobe, CovError> {
-        CovError::require_non_negative("Phong", "exponent", exponent)?;
-        Ok(Lobe::Phong { exponent })
+        Lobe::Phong { exponent }.validated()
     }
 
     /// An isotropic Beckmann lobe.
@@ -170,17 +169,16 @@ impl Lobe {
     /// Negative or non-finite parameters.
     #[inline(always)]
     pub fn validated(self) -> Result<Lobe, CovError> {
-        let params: [(&str, &str, f64); 2] = match self {
+        // Each value named by its field (`arg!`), under the variant's name.
+        let params = match self {
             Lobe::Diffuse | Lobe::Mirror => return Ok(self),
-            Lobe::Phong { exponent } => [("Phong", "exponent", exponent); 2],
-            Lobe::Gaussian { var_u, var_v } => [("Gaussian", "var_u", var_u), ("Gaussian", "var_v", var_v)],
-            Lobe::Beckmann { alpha_u, alpha_v } => {
-                [("Beckmann", "alpha_u", alpha_u), ("Beckmann", "alpha_v", alpha_v)]
-            }
-            Lobe::Ggx { alpha_u, alpha_v } => [("Ggx", "alpha_u", alpha_u), ("Ggx", "alpha_v", alpha_v)],
+            Lobe::Phong { exponent } => [arg!("Phong", exponent); 2],
+            Lobe::Gaussian { var_u, var_v } => [arg!("Gaussian", var_u), arg!("Gaussian", var_v)],
+            Lobe::Beckmann { alpha_u, alpha_v } => [arg!("Beckmann", alpha_u), arg!("Beckmann", alpha_v)],
+            Lobe::Ggx { alpha_u, alpha_v } => [arg!("Ggx", alpha_u), arg!("Ggx", alpha_v)],
         };
-        for (op, name, v) in params {
-            CovError::require_non_negative(op, name, v)?;
+        for p in params {
+            p.non_negative()?;
         }
         Ok(self)
     }
@@ -317,15 +315,32 @@ impl Reflect {
         lobe: Lobe,
         turn: f64,
     ) -> Result<Self, CovError> {
-        // Checked here under the names the user wrote (the projections would name `cos`).
-        for (name, c) in [("cos_in", cos_in), ("cos_out", cos_out)] {
-            CovError::require_range(Self::NAME, name, c, |c| c > 0.0 && c <= 1.0, "must be in (0, 1]")?;
+        // The spec's checks, under the names the user wrote (the projections would name
+        // `cos`); the curvature is given built.
+        spec::ReflectSpec {
+            cos_in,
+            cos_out,
+            curvature: CurvatureSpec::default(),
+            lobe,
+            turn,
         }
+        .check()?;
+        Self::checked(cos_in, cos_out, curvature, lobe, turn)
+    }
+
+    /// [`Reflect::with_turn`] on checked cosines.
+    fn checked(
+        cos_in: f64,
+        cos_out: f64,
+        curvature: Curvature,
+        lobe: Lobe,
+        turn: f64,
+    ) -> Result<Self, CovError> {
         Ok(Reflect {
             project: Project::new(cos_in)?,
             curvature,
             lobe: lobe.validated()?,
-            turn: Turn::new(Self::NAME, "turn", turn)?,
+            turn: Turn::new(spec::ReflectSpec::TURN.of(turn))?,
             unproject: Unproject::new(cos_out)?,
         })
     }

@@ -1,7 +1,6 @@
 //! RON parameters of the BRDF operators.
 
-use cov_core::CovError;
-use cov_core::{OperatorSpec, Registrar};
+use cov_core::{Build, Checked, CovError, OperatorSpec, Registrar};
 use cov_curvature::spec::CurvatureSpec;
 
 use crate::{Brdf, Lobe, Reflect};
@@ -14,9 +13,9 @@ pub struct BrdfSpec {
     pub lobe: Lobe,
 }
 
-impl TryFrom<BrdfSpec> for Brdf {
-    type Error = CovError;
-    fn try_from(spec: BrdfSpec) -> Result<Brdf, CovError> {
+impl Build for BrdfSpec {
+    type Op = Brdf;
+    fn make(spec: Checked<Self>) -> Result<Brdf, CovError> {
         Brdf::new(spec.lobe)
     }
 }
@@ -25,9 +24,11 @@ impl TryFrom<BrdfSpec> for Brdf {
 #[derive(Debug, OperatorSpec)]
 #[operator(summary = "reflection at a curved surface (projection, curvature, symmetry, lobe, back)")]
 pub struct ReflectSpec {
-    /// `|cos θ_in|`, in (0, 1].
+    /// `|cos θ_in|`.
+    #[param(gt = 0, le = 1)]
     pub cos_in: f64,
-    /// `|cos θ_out|`, in (0, 1].
+    /// `|cos θ_out|`.
+    #[param(gt = 0, le = 1)]
     pub cos_out: f64,
     /// Surface curvature, `(k: …)` or `(kx: …, ky: …, angle: …)`; flat when left out.
     #[param(unit = "1/m", default)]
@@ -39,10 +40,10 @@ pub struct ReflectSpec {
     pub turn: f64,
 }
 
-impl TryFrom<ReflectSpec> for Reflect {
-    type Error = CovError;
-    fn try_from(spec: ReflectSpec) -> Result<Reflect, CovError> {
-        Reflect::with_turn(
+impl Build for ReflectSpec {
+    type Op = Reflect;
+    fn make(spec: Checked<Self>) -> Result<Reflect, CovError> {
+        Reflect::checked(
             spec.cos_in,
             spec.cos_out,
             spec.curvature.to_curvature()?,

@@ -248,7 +248,14 @@ fn run(cli: Cli, registry: &Registry) -> Result<(), String> {
                 for p in e.params {
                     let default = p.default.map(|d| format!(" (default {d})")).unwrap_or_default();
                     let unit = if p.unit.is_empty() { "–" } else { p.unit };
-                    say!("    {:<10} {:<13} {}{default}", p.name, unit, p.doc);
+                    let domain = if p.domain.is_empty() { "–" } else { p.domain };
+                    say!(
+                        "    {:<10} {:<13} {:<16} {}{default}",
+                        p.name,
+                        unit,
+                        domain,
+                        p.doc
+                    );
                 }
             }
         }

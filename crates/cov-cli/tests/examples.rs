@@ -112,4 +112,15 @@ fn list_names_every_registered_operator() {
     for e in covtrace::registry().entries() {
         assert!(text.contains(&format!("{}:", e.name)), "{}", e.name);
     }
+    // Each parameter with its unit and its declared domain.
+    assert!(
+        text.lines()
+            .any(|l| l.split_whitespace().collect::<Vec<_>>()[..].starts_with(&[
+                "focus_distance",
+                "m",
+                ">",
+                "focal_length"
+            ])),
+        "{text}"
+    );
 }

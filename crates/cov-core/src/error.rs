@@ -232,6 +232,6 @@ impl CovError {
     /// [`CovError::NonFinite`] or [`CovError::OutOfRange`].
     #[inline]
     pub fn require_non_negative(operator: &str, parameter: &str, value: f64) -> Result<f64, CovError> {
-        Self::require_range(operator, parameter, value, |v| v >= 0.0, "must be >= 0")
+        Self::require_range(operator, parameter, value, |v| v >= 0.0, "must be ≥ 0")
     }
 }

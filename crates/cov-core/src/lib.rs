@@ -91,7 +91,7 @@ pub use lanes::CovLanes;
 pub use operator::{Chain, Operator, Step, Trace, check_layout};
 pub use query::{CovBlock, Filter, NYQUIST_K, primal_std_of_spectrum};
 pub use report::{Field, Report, ReportField};
-pub use spec::{OperatorReader, OperatorSpec, Param, Registrar};
+pub use spec::{Build, Checked, OperatorReader, OperatorSpec, Param, ParamValue, Registrar};
 pub use spectrum::{Concrete, Form, Spectrum, Turn, transverse_pairs};
 pub use tape::{Block, Kernel, Recorder, Tape};
 

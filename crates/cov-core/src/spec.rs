@@ -1,21 +1,52 @@
 //! Operator specs: the parameters of an operator as a file names them, declared once.
 //!
-//! A spec is a plain struct with `#[derive(OperatorSpec)]`: each field is a parameter,
-//! its doc comment the parameter's documentation, `#[param(unit = "m")]` its unit,
-//! `#[param(default)]` (or `#[param(default = expr)]`) makes it optional, and
-//! `#[param(nested)]` marks a [`Chain`] field written as an operator list. The derive
-//! generates [`OperatorSpec`]: the name, the parameter table ([`OperatorSpec::PARAMS`],
-//! shown by `covtrace list`), a reader that denies unknown fields, and the all-defaults
-//! value that lets an operator whose parameters are all optional be written bare
-//! (`Mirror`) or with parentheses (`Mirror()`). The operator is built from the spec by
-//! `TryFrom<Spec> for Op`.
+//! # Writing an operator outside covtrace
+//!
+//! **Depend on one crate**, `covtrace` (it re-exports this crate and the derive), and
+//! import `use covtrace::{Build, Checked, CovError, Operator, OperatorSpec, Registrar,
+//! Spectrum};`. Inside the workspace the same names come from `cov_core`.
+//!
+//! **Declare each parameter once**, as a field of a spec struct with
+//! `#[derive(OperatorSpec)]`:
+//!
+//! | on | attribute | meaning |
+//! |---|---|---|
+//! | struct | `#[operator(summary = "…")]` | one line for `covtrace list` (required) |
+//! | struct | `#[operator(name = "…")]` | the name in files; default: the struct's name without `Spec` (`BlurSpec` → `Blur`) |
+//! | field | `/// text` | the parameter's documentation |
+//! | field | `#[param(unit = "m")]` | its unit |
+//! | field | `#[param(default)]`, `#[param(default = expr)]` | optional, with `Default::default()` or `expr` |
+//! | field | `#[param(positive)]`, `#[param(non_negative)]` | domain `> 0`, `≥ 0` |
+//! | field | `#[param(gt = a)]`, `ge`, `lt`, `le` (one lower, one upper) | bounds: numbers, constants or other fields (`gt = self.focal_length`) |
+//! | field | `#[param(finite)]` | finite; implied for `f64`, `Option<f64>`, `Vec<f64>`, `[f64; N]` |
+//! | field | `#[param(nested)]` | a [`Chain`] written as an operator list |
+//!
+//! **Say which operator the spec builds, and how**, with [`Build`]: `type Op` names the
+//! operator type (whatever its name) and [`Build::make`] receives the spec [`Checked`]
+//! against every declared domain. Checks that relate parameters, or that the derive
+//! cannot express, go there and report through the spec's parameter constants
+//! (`MySpec::FIELD`, one per field, a [`Param`]): no parameter name is typed twice.
+//! Values that are not fields (an enum variant's field, a function's argument) are named
+//! by their identifier with [`arg!`](crate::arg).
+//!
+//! **Register** with one call, `registry.add::<MySpec>()` on any [`Registrar`] (the RON
+//! registry of `covtrace::registry()`, a [`Catalogue`]); a crate of operators offers
+//! `pub fn register<R: Registrar>(r: &mut R)`.
+//!
+//! **What comes for free**: the RON syntax (`Blur(s: 4.0)`, defaults, `Blur` bare when
+//! every parameter is optional), errors positioned at the parameter as written
+//! (`file:line:column`, for unknown, repeated, missing and out-of-domain parameters), the
+//! parameter table of `covtrace list` and of the docs (name, unit, default, domain,
+//! meaning), `eval`/`plot`/`validate` through `covtrace_cli::run_with`, and the checked
+//! constructor for Rust callers ([`OperatorSpec::build`]: an operator's `new` is
+//! `MySpec { … }.build()`, the same checks as a file's).
 //!
 //! Nothing here knows a file format: the format crate (`cov-path`, RON) drives
 //! [`OperatorSpec::deserialize_in`] with its own deserializer and an [`OperatorReader`]
 //! for nested lists, and collects specs through [`Registrar`].
 //!
 //! ```
-//! use cov_core::{Axis, CovError, Operator, OperatorSpec, Spectrum};
+//! use cov_core::{Axis, Build, Checked, CovError, Operator, OperatorSpec, Spectrum};
 //!
 //! /// An angular blur.
 //! #[derive(Debug)]
@@ -30,23 +61,29 @@
 //! #[derive(Debug, OperatorSpec)]
 //! #[operator(summary = "an angular blur")]
 //! pub struct BlurSpec {
-//!     /// Lobe spectrum variance, ≥ 0.
-//!     #[param(unit = "(cycles/tan)²", default = 1.0)]
+//!     /// Lobe spectrum variance.
+//!     #[param(unit = "(cycles/tan)²", default = 1.0, non_negative)]
 //!     pub s: f64,
 //! }
-//! impl TryFrom<BlurSpec> for Blur {
-//!     type Error = CovError;
-//!     fn try_from(spec: BlurSpec) -> Result<Blur, CovError> {
-//!         Ok(Blur(CovError::require_non_negative("Blur", "s", spec.s)?))
+//! impl Build for BlurSpec {
+//!     type Op = Blur;
+//!     fn make(spec: Checked<Self>) -> Result<Blur, CovError> {
+//!         Ok(Blur(spec.s)) // `s` is finite and ≥ 0 here
 //!     }
 //! }
 //!
 //! assert_eq!(BlurSpec::NAME, "Blur");
-//! assert_eq!(BlurSpec::PARAMS[0].name, "s");
-//! assert_eq!(BlurSpec::PARAMS[0].unit, "(cycles/tan)²");
-//! assert_eq!(BlurSpec::PARAMS[0].doc, "Lobe spectrum variance, ≥ 0.");
-//! assert_eq!(BlurSpec::PARAMS[0].default, Some("1.0"));
+//! assert_eq!(BlurSpec::PARAMS[0], BlurSpec::S);
+//! assert_eq!(BlurSpec::S.name, "s");
+//! assert_eq!(BlurSpec::S.unit, "(cycles/tan)²");
+//! assert_eq!(BlurSpec::S.doc, "Lobe spectrum variance.");
+//! assert_eq!(BlurSpec::S.default, Some("1.0"));
+//! assert_eq!(BlurSpec::S.domain, "≥ 0");
 //! assert!(BlurSpec::defaults().is_some());
+//! // Rust callers get the same checks as files.
+//! let err = BlurSpec { s: -1.0 }.build().unwrap_err().to_string();
+//! assert_eq!(err, "Blur: parameter `s` = -1 is out of range: must be ≥ 0");
+//! assert!(BlurSpec { s: f64::NAN }.build().is_err());
 //! ```
 
 use std::fmt;
@@ -55,36 +92,387 @@ use serde::de::{DeserializeSeed, Deserializer, Visitor};
 
 use crate::{Chain, CovError, Operator};
 
-/// One documented parameter of an operator (for `covtrace list` and the docs).
+/// One documented parameter of an operator: what `covtrace list` and the docs show, and
+/// what its errors name. The derive makes one per field, as an associated constant of the
+/// spec named after the field (`ThinLensSpec::FOCAL_LENGTH`), so code that reports a
+/// parameter (a constraint relating two of them) names it through the constant and never
+/// types the name.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Param {
+    /// The operator's name in files.
+    pub operator: &'static str,
     /// Field name as written in a file.
     pub name: &'static str,
     /// Unit (`m`, `1/m`, `rad`, …; empty when dimensionless).
     pub unit: &'static str,
-    /// What it means and its domain (the field's doc comment).
+    /// What it means (the field's doc comment).
     pub doc: &'static str,
     /// The default, as written in the source, when the parameter may be left out.
     pub default: Option<&'static str>,
+    /// Its domain as declared by `#[param(…)]` (`> 0`, `in (0, 1]`, `finite`; empty when
+    /// the field's type has no declared domain).
+    pub domain: &'static str,
+}
+
+impl Param {
+    /// This parameter with a value, for functions that take an [`Arg`] (`Turn::new`).
+    pub fn of(&self, value: f64) -> Arg {
+        Arg {
+            operator: self.operator,
+            name: self.name,
+            value,
+            index: None,
+        }
+    }
+
+    /// The error for `value`, out of this parameter's domain: `expected` says the domain
+    /// in words (`must be > focal_length = 0.05`).
+    #[cold]
+    pub fn error(&self, value: f64, expected: impl Into<String>) -> CovError {
+        CovError::OutOfRange {
+            operator: self.operator.into(),
+            parameter: self.name.into(),
+            value,
+            expected: expected.into(),
+        }
+    }
+
+    /// `value` if it is finite and `ok(value)`, else the error naming this parameter, with
+    /// `expected()` (built only on failure) saying the domain.
+    ///
+    /// # Errors
+    /// [`CovError::NonFinite`] or [`CovError::OutOfRange`].
+    #[inline]
+    pub fn require(
+        &self,
+        value: f64,
+        ok: impl FnOnce(f64) -> bool,
+        expected: impl FnOnce() -> String,
+    ) -> Result<f64, CovError> {
+        self.require_named(None, value, ok, expected)
+    }
+
+    /// [`Param::require`] for element `k` of a list parameter (named `values[k]`).
+    ///
+    /// # Errors
+    /// [`CovError::NonFinite`] or [`CovError::OutOfRange`].
+    #[inline]
+    pub fn require_at(
+        &self,
+        k: usize,
+        value: f64,
+        ok: impl FnOnce(f64) -> bool,
+        expected: impl FnOnce() -> String,
+    ) -> Result<f64, CovError> {
+        self.require_named(Some(k), value, ok, expected)
+    }
+
+    #[inline]
+    fn require_named(
+        &self,
+        k: Option<usize>,
+        value: f64,
+        ok: impl FnOnce(f64) -> bool,
+        expected: impl FnOnce() -> String,
+    ) -> Result<f64, CovError> {
+        if value.is_finite() && ok(value) {
+            return Ok(value);
+        }
+        Err(self.fail(k, value, value.is_finite().then(expected)))
+    }
+
+    #[cold]
+    fn fail(&self, k: Option<usize>, value: f64, expected: Option<String>) -> CovError {
+        let parameter = match k {
+            Some(k) => format!("{}[{k}]", self.name),
+            None => self.name.to_string(),
+        };
+        match expected {
+            None => CovError::NonFinite {
+                operator: self.operator.into(),
+                parameter,
+                value,
+            },
+            Some(expected) => CovError::OutOfRange {
+                operator: self.operator.into(),
+                parameter,
+                value,
+                expected,
+            },
+        }
+    }
+}
+
+/// A value given to a Rust constructor that is not a spec's field (an enum variant's
+/// field, an argument computed by a renderer), checked like a parameter and named after
+/// its identifier: `arg!(Texture::NAME, mean_sq).non_negative()?`, or an element of a
+/// list, `arg!("Tabulated", values[k])` (named `values[k]` with `k`'s value). The name is
+/// never typed as a string, so it cannot drift from the code.
+#[macro_export]
+macro_rules! arg {
+    ($operator:expr, $value:ident) => {
+        $crate::spec::Arg {
+            operator: $operator,
+            name: ::core::stringify!($value),
+            value: $value,
+            index: ::core::option::Option::None,
+        }
+    };
+    ($operator:expr, $list:ident[$k:expr]) => {
+        $crate::spec::Arg {
+            operator: $operator,
+            name: ::core::stringify!($list),
+            value: $list[$k],
+            index: ::core::option::Option::Some($k),
+        }
+    };
+}
+
+/// See [`arg!`](crate::arg).
+#[derive(Clone, Copy, Debug)]
+pub struct Arg {
+    /// The operator or function taking it.
+    pub operator: &'static str,
+    /// Its name (the identifier).
+    pub name: &'static str,
+    /// Its value.
+    pub value: f64,
+    /// The element, for an element of a list.
+    pub index: Option<usize>,
+}
+
+impl Arg {
+    fn param(&self) -> Param {
+        Param {
+            operator: self.operator,
+            name: self.name,
+            unit: "",
+            doc: "",
+            default: None,
+            domain: "",
+        }
+    }
+
+    /// The value if it is finite and `ok(value)`.
+    ///
+    /// # Errors
+    /// [`CovError::NonFinite`] or [`CovError::OutOfRange`] with `expected`.
+    #[inline]
+    pub fn require(
+        self,
+        ok: impl FnOnce(f64) -> bool,
+        expected: impl FnOnce() -> String,
+    ) -> Result<f64, CovError> {
+        self.param().require_named(self.index, self.value, ok, expected)
+    }
+
+    /// The value if it is finite.
+    ///
+    /// # Errors
+    /// [`CovError::NonFinite`].
+    #[inline]
+    pub fn finite(self) -> Result<f64, CovError> {
+        self.require(|_| true, String::new)
+    }
+
+    /// The value if it is finite and > 0.
+    ///
+    /// # Errors
+    /// [`CovError::NonFinite`] or [`CovError::OutOfRange`].
+    #[inline]
+    pub fn positive(self) -> Result<f64, CovError> {
+        self.require(|v| v > 0.0, || "must be > 0".into())
+    }
+
+    /// The value if it is finite and ≥ 0.
+    ///
+    /// # Errors
+    /// [`CovError::NonFinite`] or [`CovError::OutOfRange`].
+    #[inline]
+    pub fn non_negative(self) -> Result<f64, CovError> {
+        self.require(|v| v >= 0.0, || "must be ≥ 0".into())
+    }
+
+    /// The error for this value, out of its domain.
+    #[cold]
+    pub fn error(self, expected: impl Into<String>) -> CovError {
+        self.param().fail(self.index, self.value, Some(expected.into()))
+    }
+}
+
+/// A value of a parameter with a declared domain: what the code `#[derive(OperatorSpec)]`
+/// generates calls to check a field. Implemented for `f64` and the integers (the value
+/// itself), `Option` (when given) and lists of numbers (each element, named `name[k]`).
+#[diagnostic::on_unimplemented(
+    message = "a `#[param(…)]` domain cannot be checked on a `{Self}`",
+    note = "domains (`finite`, `positive`, `non_negative`, `gt`, `ge`, `lt`, `le`) apply to numbers, their `Option`s and lists; check other types in `Build::make`"
+)]
+pub trait ParamValue {
+    /// Checks every number in `self` against `ok` (and finiteness).
+    ///
+    /// # Errors
+    /// The first number out of its domain, named after `p`.
+    fn check_param(
+        &self,
+        p: &Param,
+        ok: impl Fn(f64) -> bool,
+        expected: impl Fn() -> String,
+    ) -> Result<(), CovError>;
+}
+
+impl ParamValue for f64 {
+    #[inline]
+    fn check_param(
+        &self,
+        p: &Param,
+        ok: impl Fn(f64) -> bool,
+        expected: impl Fn() -> String,
+    ) -> Result<(), CovError> {
+        p.require(*self, ok, expected).map(|_| ())
+    }
+}
+
+macro_rules! integer_param {
+    ($($t:ty),*) => {$(
+        impl ParamValue for $t {
+            #[inline]
+            fn check_param(
+                &self,
+                p: &Param,
+                ok: impl Fn(f64) -> bool,
+                expected: impl Fn() -> String,
+            ) -> Result<(), CovError> {
+                // Exact for every count a user may give (≤ 2⁵³).
+                #[allow(clippy::cast_precision_loss)]
+                let v = *self as f64;
+                p.require(v, ok, expected).map(|_| ())
+            }
+        }
+    )*};
+}
+integer_param!(u32, u64, usize, i32, i64);
+
+impl<T: ParamValue> ParamValue for Option<T> {
+    #[inline]
+    fn check_param(
+        &self,
+        p: &Param,
+        ok: impl Fn(f64) -> bool,
+        expected: impl Fn() -> String,
+    ) -> Result<(), CovError> {
+        match self {
+            Some(v) => v.check_param(p, ok, expected),
+            None => Ok(()),
+        }
+    }
+}
+
+impl ParamValue for [f64] {
+    fn check_param(
+        &self,
+        p: &Param,
+        ok: impl Fn(f64) -> bool,
+        expected: impl Fn() -> String,
+    ) -> Result<(), CovError> {
+        for (k, &v) in self.iter().enumerate() {
+            p.require_at(k, v, &ok, &expected)?;
+        }
+        Ok(())
+    }
+}
+
+impl ParamValue for Vec<f64> {
+    #[inline]
+    fn check_param(
+        &self,
+        p: &Param,
+        ok: impl Fn(f64) -> bool,
+        expected: impl Fn() -> String,
+    ) -> Result<(), CovError> {
+        self.as_slice().check_param(p, ok, expected)
+    }
+}
+
+impl<const N: usize> ParamValue for [f64; N] {
+    #[inline]
+    fn check_param(
+        &self,
+        p: &Param,
+        ok: impl Fn(f64) -> bool,
+        expected: impl Fn() -> String,
+    ) -> Result<(), CovError> {
+        self.as_slice().check_param(p, ok, expected)
+    }
+}
+
+/// A spec whose declared domains have been checked ([`OperatorSpec::check`]): what
+/// [`Build::make`] receives, so an operator is never built from unchecked parameters.
+/// Only [`OperatorSpec::build`] makes one.
+#[derive(Debug)]
+pub struct Checked<S>(S);
+
+impl<S> Checked<S> {
+    /// The spec itself (to move its fields out).
+    pub fn into_inner(self) -> S {
+        self.0
+    }
+}
+
+impl<S> std::ops::Deref for Checked<S> {
+    type Target = S;
+    fn deref(&self) -> &S {
+        &self.0
+    }
+}
+
+/// How an operator is made from its spec, once the spec's declared domains hold. The one
+/// thing a spec implements by hand, next to `#[derive(OperatorSpec)]`.
+#[diagnostic::on_unimplemented(
+    message = "`{Self}` derives `OperatorSpec` but does not say which operator it builds, or how",
+    label = "no `impl Build for {Self}`",
+    note = "add `impl Build for {Self} {{ type Op = YourOperator; fn make(spec: Checked<Self>) -> Result<YourOperator, CovError> {{ … }} }}` (`use covtrace::{{Build, Checked}}`, or `cov_core::…`)",
+    note = "the operator's type is named there, by `type Op`, whatever its name; the parameters' `#[param(…)]` domains are checked before `make` runs"
+)]
+pub trait Build: Sized {
+    /// The operator built from the parameters.
+    type Op: Operator + 'static;
+
+    /// Makes the operator from checked parameters, with any check that relates several
+    /// of them (reported through the spec's parameter constants).
+    ///
+    /// # Errors
+    /// Parameters that are valid one by one but not together.
+    fn make(spec: Checked<Self>) -> Result<Self::Op, CovError>;
 }
 
 /// The parameters of an operator as written in a file, and how to build it. Derive it
-/// (`#[derive(OperatorSpec)]`, see the module docs) rather than implementing it by hand.
-pub trait OperatorSpec: Sized + 'static {
+/// (`#[derive(OperatorSpec)]`, see the module docs) rather than implementing it by hand;
+/// implement [`Build`] next to it.
+pub trait OperatorSpec: Build + 'static {
     /// The name used in files (`Travel`).
     const NAME: &'static str;
     /// One line describing the operator.
     const SUMMARY: &'static str;
     /// The parameters, in the order of the struct.
     const PARAMS: &'static [Param];
-    /// The operator built from the parameters.
-    type Op: Operator + 'static;
 
-    /// Validates the parameters and builds the operator.
+    /// Checks every parameter against its declared domain (`#[param(positive)]`, …;
+    /// finiteness for numbers).
+    ///
+    /// # Errors
+    /// The first parameter out of its domain, named as in files.
+    fn check(&self) -> Result<(), CovError>;
+
+    /// Checks the parameters and builds the operator: the one way from a spec to an
+    /// operator, for files and for Rust callers alike.
     ///
     /// # Errors
     /// Invalid parameters (NaN, out of range): the message names the parameter.
-    fn build(self) -> Result<Self::Op, CovError>;
+    #[inline]
+    fn build(self) -> Result<Self::Op, CovError> {
+        self.check()?;
+        <Self as Build>::make(Checked(self))
+    }
 
     /// Reads the parameters from `d` (a struct of named fields; unknown and repeated
     /// fields are errors, optional ones take their defaults), with nested operator lists
@@ -128,7 +516,7 @@ pub trait Registrar {
 /// # use cov_core::{CovError, Operator, OperatorSpec, Registrar, Spectrum};
 /// # #[derive(Debug)] pub struct Nudge;
 /// # impl Operator for Nudge { fn apply(&self, _: &mut dyn Spectrum) -> Result<(), CovError> { Ok(()) } }
-/// # impl TryFrom<NudgeSpec> for Nudge { type Error = CovError; fn try_from(_: NudgeSpec) -> Result<Nudge, CovError> { Ok(Nudge) } }
+/// # impl cov_core::Build for NudgeSpec { type Op = Nudge; fn make(_: cov_core::Checked<Self>) -> Result<Nudge, CovError> { Ok(Nudge) } }
 /// /// `Nudge(by: 0.1)`.
 /// #[derive(OperatorSpec)]
 /// #[operator(summary = "does nothing, gently")]
@@ -139,7 +527,7 @@ pub trait Registrar {
 /// }
 /// let mut c = Catalogue::default();
 /// c.add::<NudgeSpec>();
-/// assert!(c.markdown().contains("| `Nudge` | `by` | m | `0.1` | How much. |"));
+/// assert!(c.markdown().contains("| `Nudge` | `by` | m | `0.1` | finite | How much. |"));
 /// ```
 #[derive(Clone, Debug, Default)]
 pub struct Catalogue {
@@ -171,14 +559,15 @@ impl Registrar for Catalogue {
 
 impl Catalogue {
     /// The parameter table in Markdown: one row per parameter (one for an operator
-    /// without any), columns operator, parameter, unit, default, meaning.
+    /// without any), columns operator, parameter, unit, default, domain, meaning.
     pub fn markdown(&self) -> String {
-        let mut out =
-            String::from("| operator | parameter | unit | default | meaning |\n|---|---|---|---|---|\n");
+        let mut out = String::from(
+            "| operator | parameter | unit | default | domain | meaning |\n|---|---|---|---|---|---|\n",
+        );
         for e in &self.entries {
             if e.params.is_empty() {
                 out.push_str(&format!(
-                    "| `{}` | – | | | {} (no parameters) |\n",
+                    "| `{}` | – | | | | {} (no parameters) |\n",
                     e.name, e.summary
                 ));
             }
@@ -195,7 +584,11 @@ impl Catalogue {
                     Some(d) => format!("`{d}`"),
                 };
                 let doc = p.doc.replace('|', "\\|");
-                out.push_str(&format!("| {op} | `{}` | {unit} | {default} | {doc} |\n", p.name));
+                let domain = if p.domain.is_empty() { "–" } else { p.domain };
+                out.push_str(&format!(
+                    "| {op} | `{}` | {unit} | {default} | {domain} | {doc} |\n",
+                    p.name
+                ));
             }
         }
         out

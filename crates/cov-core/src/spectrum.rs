@@ -254,7 +254,7 @@ pub trait Spectrum: fmt::Debug {
     /// [`CovError::MissingAxis`] in flatland (N = 2, 3); non-finite `angle`.
     #[inline(always)]
     fn rotate_frame(&mut self, angle: f64) -> Result<(), CovError> {
-        self.rotate_frame_by(Turn::new("rotate_frame", "angle", angle)?)
+        self.rotate_frame_by(Turn::new(crate::arg!("rotate_frame", angle))?)
     }
 
     /// [`Spectrum::rotate_frame`] by a [`Turn`], whose cosine and sine were computed when
@@ -483,13 +483,15 @@ pub(crate) fn two_axes(n: usize, op: &str, a: Axis, b: Axis) -> Result<(usize, u
 ///
 /// ```
 /// use cov_core::{Cov, Spectrum, Turn};
-/// let turn = Turn::new("MyOperator", "angle", 0.3)?;
+/// let angle = 0.3;
+/// let turn = Turn::new(cov_core::arg!("MyOperator", angle))?;
 /// let (mut a, mut b) = (Cov::<4>::from_diagonal([1.0, 2.0, 3.0, 4.0])?, Cov::<4>::from_diagonal([1.0, 2.0, 3.0, 4.0])?);
 /// a.rotate_frame_by(turn)?;
 /// b.rotate_frame(0.3)?;
 /// assert_eq!(a, b); // the same bits
 /// // A non-finite angle names the operator and parameter it came from.
-/// let err = Turn::new("MyOperator", "angle", f64::NAN).unwrap_err().to_string();
+/// let angle = f64::NAN;
+/// let err = Turn::new(cov_core::arg!("MyOperator", angle)).unwrap_err().to_string();
 /// assert!(err.contains("MyOperator") && err.contains("angle"));
 /// # Ok::<(), cov_core::CovError>(())
 /// ```
@@ -508,14 +510,15 @@ impl Turn {
         sin: 0.0,
     };
 
-    /// The rotation by `angle` (radians); `operator` and `parameter` name the angle in
-    /// the error.
+    /// The rotation by an angle (radians) given as an [`Arg`](crate::spec::Arg), which
+    /// names it in the error: `Turn::new(arg!("MyOperator", angle))`, or
+    /// `Turn::new(MySpec::ANGLE.of(angle))` for a spec's parameter.
     ///
     /// # Errors
-    /// [`CovError::NonFinite`] for a non-finite `angle`.
+    /// [`CovError::NonFinite`] for a non-finite angle.
     #[inline]
-    pub fn new(operator: &str, parameter: &str, angle: f64) -> Result<Turn, CovError> {
-        let angle = CovError::require_finite(operator, parameter, angle)?;
+    pub fn new(angle: crate::spec::Arg) -> Result<Turn, CovError> {
+        let angle = angle.finite()?;
         if angle == 0.0 {
             // The common "no turn": `sin_cos(±0)` is exactly (±0, 1), without the call.
             return Ok(Turn {

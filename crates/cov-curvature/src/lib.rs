@@ -13,15 +13,15 @@
 //! Parameters, as written in a path file (`covtrace list` prints the same):
 //!
 //! <!-- parameters: generated from the specs (`COVTRACE_BLESS=1 cargo test --test param_tables`) -->
-//! | operator | parameter | unit | default | meaning |
-//! |---|---|---|---|---|
-//! | `Curvature` | `k` | 1/m | optional | Isotropic curvature (> 0 convex). |
-//! |  | `kx` | 1/m | optional | First principal curvature, along `angle`. |
-//! |  | `ky` | 1/m | optional | Second principal curvature, across `angle`. |
-//! |  | `angle` | rad | optional | Angle of the first principal direction from x. |
-//! | `CurvatureTensor` | `kxx` | 1/m | required | `K_xx`, finite. |
-//! |  | `kxy` | 1/m | optional | `K_xy`, finite. |
-//! |  | `kyy` | 1/m | optional | `K_yy`, finite. |
+//! | operator | parameter | unit | default | domain | meaning |
+//! |---|---|---|---|---|---|
+//! | `Curvature` | `k` | 1/m | optional | finite | Isotropic curvature (> 0 convex). |
+//! |  | `kx` | 1/m | optional | finite | First principal curvature, along `angle`. |
+//! |  | `ky` | 1/m | optional | finite | Second principal curvature, across `angle`. |
+//! |  | `angle` | rad | optional | finite | Angle of the first principal direction from x. |
+//! | `CurvatureTensor` | `kxx` | 1/m | required | finite | `K_xx`. |
+//! |  | `kxy` | 1/m | optional | finite | `K_xy`. |
+//! |  | `kyy` | 1/m | optional | finite | `K_yy`. |
 //! <!-- end of parameters -->
 //!
 //! An anisotropic curvature (`kx ≠ ky` or `angle ≠ 0`) needs the 3D layout; an isotropic
@@ -58,7 +58,7 @@
 
 pub mod spec;
 
-use cov_core::{Axis, AxisSet, CovError, Operator, Spectrum, Turn};
+use cov_core::{Axis, AxisSet, CovError, Operator, OperatorSpec, Spectrum, Turn, arg};
 
 /// Curvature by principal curvatures and direction.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -89,10 +89,22 @@ impl Curvature {
     /// Non-finite parameters.
     #[inline]
     pub fn anisotropic(kx: f64, ky: f64, angle: f64) -> Result<Self, CovError> {
+        spec::CurvatureSpec {
+            k: None,
+            kx: Some(kx),
+            ky: Some(ky),
+            angle: Some(angle),
+        }
+        .build()
+    }
+
+    /// From curvatures checked by the spec.
+    #[inline]
+    fn checked(kx: f64, ky: f64, angle: f64) -> Result<Self, CovError> {
         Ok(Curvature {
-            kx: CovError::require_finite(Self::NAME, "kx", kx)?,
-            ky: CovError::require_finite(Self::NAME, "ky", ky)?,
-            turn: Turn::new(Self::NAME, "angle", angle)?,
+            kx,
+            ky,
+            turn: Turn::new(spec::CurvatureSpec::ANGLE.of(angle))?,
         })
     }
 
@@ -128,14 +140,8 @@ impl Curvature {
     /// # Errors
     /// `cos` not in (0, 1], `sign` not finite, overflow.
     pub fn apply_oblique(&self, cov: &mut dyn Spectrum, cos: f64, sign: f64) -> Result<(), CovError> {
-        CovError::require_range(
-            Self::NAME,
-            "cos",
-            cos,
-            |c| c > 0.0 && c <= 1.0,
-            "must be in (0, 1]",
-        )?;
-        CovError::require_finite(Self::NAME, "sign", sign)?;
+        arg!(Self::NAME, cos).require(|c| c > 0.0 && c <= 1.0, || "must be in (0, 1]".into())?;
+        arg!(Self::NAME, sign).finite()?;
         let (kxx, kxy, kyy) = self.tensor();
         if !cov.has(Axis::Y) {
             if !self.is_isotropic() {
@@ -217,13 +223,7 @@ impl CurvatureTensor {
     /// Non-finite entries.
     #[inline]
     pub fn new(kxx: f64, kxy: f64, kyy: f64) -> Result<Self, CovError> {
-        Ok(CurvatureTensor {
-            k: [
-                CovError::require_finite(Self::NAME, "kxx", kxx)?,
-                CovError::require_finite(Self::NAME, "kxy", kxy)?,
-                CovError::require_finite(Self::NAME, "kyy", kyy)?,
-            ],
-        })
+        spec::CurvatureTensorSpec { kxx, kxy, kyy }.build()
     }
 }
 

@@ -1,7 +1,6 @@
 //! RON parameters of the curvature operators.
 
-use cov_core::CovError;
-use cov_core::{OperatorSpec, Registrar};
+use cov_core::{Build, Checked, CovError, OperatorSpec, Registrar};
 use serde::Deserialize;
 
 use crate::{Curvature, CurvatureTensor};
@@ -36,25 +35,27 @@ impl CurvatureSpec {
     /// # Errors
     /// Both `k` and `kx`/`ky` given, or invalid values.
     pub fn to_curvature(self) -> Result<Curvature, CovError> {
-        match (self.k, self.kx, self.ky) {
-            (Some(k), None, None) if self.angle.is_none() => Curvature::isotropic(k),
-            (None, kx, ky) => {
-                Curvature::anisotropic(kx.unwrap_or(0.0), ky.unwrap_or(0.0), self.angle.unwrap_or(0.0))
-            }
-            _ => Err(CovError::OutOfRange {
-                operator: Curvature::NAME.into(),
-                parameter: "k / kx, ky, angle".into(),
-                value: f64::NAN,
-                expected: "give either `k` alone or the principal form `kx`, `ky`, `angle`".into(),
-            }),
-        }
+        self.build()
     }
 }
 
-impl TryFrom<CurvatureSpec> for Curvature {
-    type Error = CovError;
-    fn try_from(spec: CurvatureSpec) -> Result<Curvature, CovError> {
-        spec.to_curvature()
+impl Build for CurvatureSpec {
+    type Op = Curvature;
+    #[inline]
+    fn make(spec: Checked<Self>) -> Result<Curvature, CovError> {
+        match (spec.k, spec.kx, spec.ky) {
+            (Some(k), None, None) if spec.angle.is_none() => Curvature::checked(k, k, 0.0),
+            (None, kx, ky) => {
+                Curvature::checked(kx.unwrap_or(0.0), ky.unwrap_or(0.0), spec.angle.unwrap_or(0.0))
+            }
+            (k, _, _) => {
+                let [k_, kx, ky, angle] = [&Self::K, &Self::KX, &Self::KY, &Self::ANGLE].map(|p| p.name);
+                Err(Self::K.error(
+                    k.unwrap_or(f64::NAN),
+                    format!("give either `{k_}` alone or the principal form `{kx}`, `{ky}`, `{angle}`"),
+                ))
+            }
+        }
     }
 }
 
@@ -62,21 +63,24 @@ impl TryFrom<CurvatureSpec> for Curvature {
 #[derive(Debug, OperatorSpec)]
 #[operator(summary = "surface curvature given by its tensor in the frame")]
 pub struct CurvatureTensorSpec {
-    /// `K_xx`, finite.
+    /// `K_xx`.
     #[param(unit = "1/m")]
     pub kxx: f64,
-    /// `K_xy`, finite.
+    /// `K_xy`.
     #[param(unit = "1/m", default)]
     pub kxy: f64,
-    /// `K_yy`, finite.
+    /// `K_yy`.
     #[param(unit = "1/m", default)]
     pub kyy: f64,
 }
 
-impl TryFrom<CurvatureTensorSpec> for CurvatureTensor {
-    type Error = CovError;
-    fn try_from(spec: CurvatureTensorSpec) -> Result<CurvatureTensor, CovError> {
-        CurvatureTensor::new(spec.kxx, spec.kxy, spec.kyy)
+impl Build for CurvatureTensorSpec {
+    type Op = CurvatureTensor;
+    #[inline]
+    fn make(spec: Checked<Self>) -> Result<CurvatureTensor, CovError> {
+        Ok(CurvatureTensor {
+            k: [spec.kxx, spec.kxy, spec.kyy],
+        })
     }
 }
 

@@ -15,12 +15,12 @@
 //! Parameters, as written in a path file (`covtrace list` prints the same):
 //!
 //! <!-- parameters: generated from the specs (`COVTRACE_BLESS=1 cargo test --test param_tables`) -->
-//! | operator | parameter | unit | default | meaning |
-//! |---|---|---|---|---|
-//! | `ThinLens` | `focal_length` | m | required | Focal length, > 0. |
-//! |  | `aperture` | m | required | Std of the aperture, > 0 (a disk of radius R: R/2). |
-//! |  | `focus_distance` | m | required | Focus distance, > `focal_length`. |
-//! | `Pinhole` | `sensor_distance` | m | required | Pinhole to sensor, > 0. |
+//! | operator | parameter | unit | default | domain | meaning |
+//! |---|---|---|---|---|---|
+//! | `ThinLens` | `focal_length` | m | required | > 0 | Focal length. |
+//! |  | `aperture` | m | required | > 0 | Std of the aperture (a disk of radius R: R/2). |
+//! |  | `focus_distance` | m | required | > focal_length | Focus distance (beyond the focal length: a real image). |
+//! | `Pinhole` | `sensor_distance` | m | required | > 0 | Pinhole to sensor. |
 //! <!-- end of parameters -->
 //!
 //! **Worked example**: `f = 50 mm`, focus at `2 m` → `d_s = 0.05·2/1.95 = 51.28 mm`. A point
@@ -55,7 +55,7 @@
 
 pub mod spec;
 
-use cov_core::{CovError, FOUR_PI_SQ, Operator, Spectrum};
+use cov_core::{CovError, FOUR_PI_SQ, Operator, OperatorSpec, Spectrum};
 
 /// A thin lens with a Gaussian aperture, focused at `focus_distance`; ends at the sensor.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -73,22 +73,12 @@ impl ThinLens {
     /// Non-positive or non-finite parameters, or `focus_distance ≤ focal_length` (no real
     /// image).
     pub fn new(focal_length: f64, aperture: f64, focus_distance: f64) -> Result<Self, CovError> {
-        CovError::require_positive(Self::NAME, "focal_length", focal_length)?;
-        CovError::require_positive(Self::NAME, "aperture", aperture)?;
-        CovError::require_range(
-            Self::NAME,
-            "focus_distance",
-            focus_distance,
-            |d| d > focal_length,
-            &format!("must be > focal_length = {focal_length} (a real image)"),
-        )?;
-        let d_s = focal_length * focus_distance / (focus_distance - focal_length);
-        CovError::require_finite(Self::NAME, "sensor distance", d_s)?;
-        Ok(ThinLens {
-            f: focal_length,
+        spec::ThinLensSpec {
+            focal_length,
             aperture,
-            d_s,
-        })
+            focus_distance,
+        }
+        .build()
     }
 
     /// Lens-to-sensor distance `d_s` (m).
@@ -127,9 +117,7 @@ impl Pinhole {
     /// # Errors
     /// Non-positive or non-finite distance.
     pub fn new(sensor_distance: f64) -> Result<Self, CovError> {
-        Ok(Pinhole {
-            d_s: CovError::require_positive(Self::NAME, "sensor_distance", sensor_distance)?,
-        })
+        spec::PinholeSpec { sensor_distance }.build()
     }
 }
 

@@ -1,7 +1,6 @@
 //! RON parameters of the lens operators.
 
-use cov_core::CovError;
-use cov_core::{OperatorSpec, Registrar};
+use cov_core::{Build, Checked, CovError, OperatorSpec, Registrar};
 
 use crate::{Pinhole, ThinLens};
 
@@ -9,21 +8,32 @@ use crate::{Pinhole, ThinLens};
 #[derive(Debug, OperatorSpec)]
 #[operator(summary = "thin lens with a Gaussian aperture, travel to the sensor")]
 pub struct ThinLensSpec {
-    /// Focal length, > 0.
-    #[param(unit = "m")]
+    /// Focal length.
+    #[param(unit = "m", positive)]
     pub focal_length: f64,
-    /// Std of the aperture, > 0 (a disk of radius R: R/2).
-    #[param(unit = "m")]
+    /// Std of the aperture (a disk of radius R: R/2).
+    #[param(unit = "m", positive)]
     pub aperture: f64,
-    /// Focus distance, > `focal_length`.
-    #[param(unit = "m")]
+    /// Focus distance (beyond the focal length: a real image).
+    #[param(unit = "m", gt = self.focal_length)]
     pub focus_distance: f64,
 }
 
-impl TryFrom<ThinLensSpec> for ThinLens {
-    type Error = CovError;
-    fn try_from(spec: ThinLensSpec) -> Result<ThinLens, CovError> {
-        ThinLens::new(spec.focal_length, spec.aperture, spec.focus_distance)
+impl Build for ThinLensSpec {
+    type Op = ThinLens;
+    fn make(spec: Checked<Self>) -> Result<ThinLens, CovError> {
+        let (f, d) = (spec.focal_length, spec.focus_distance);
+        // Thin-lens equation; overflows only for a focus distance a rounding above f.
+        let d_s = f * d / (d - f);
+        if !d_s.is_finite() {
+            return Err(ThinLensSpec::FOCUS_DISTANCE
+                .error(d, "too close to focal_length: the sensor distance overflows"));
+        }
+        Ok(ThinLens {
+            f,
+            aperture: spec.aperture,
+            d_s,
+        })
     }
 }
 
@@ -31,15 +41,17 @@ impl TryFrom<ThinLensSpec> for ThinLens {
 #[derive(Debug, OperatorSpec)]
 #[operator(summary = "pinhole camera (the zero-aperture limit, in closed form)")]
 pub struct PinholeSpec {
-    /// Pinhole to sensor, > 0.
-    #[param(unit = "m")]
+    /// Pinhole to sensor.
+    #[param(unit = "m", positive)]
     pub sensor_distance: f64,
 }
 
-impl TryFrom<PinholeSpec> for Pinhole {
-    type Error = CovError;
-    fn try_from(spec: PinholeSpec) -> Result<Pinhole, CovError> {
-        Pinhole::new(spec.sensor_distance)
+impl Build for PinholeSpec {
+    type Op = Pinhole;
+    fn make(spec: Checked<Self>) -> Result<Pinhole, CovError> {
+        Ok(Pinhole {
+            d_s: spec.sensor_distance,
+        })
     }
 }
 

@@ -7,17 +7,24 @@
 //! | attribute | on | meaning |
 //! |---|---|---|
 //! | `#[operator(name = "Travel")]` | struct | name in files (default: the struct's name without `Spec`) |
-//! | `#[operator(op = Travel)]` | struct | the operator type, built by `TryFrom<Spec>` (default: the name) |
 //! | `#[operator(summary = "…")]` | struct | one line for `covtrace list` (required) |
 //! | `/// text` | field | the parameter's documentation |
 //! | `#[param(unit = "m")]` | field | its unit (default: none) |
 //! | `#[param(default)]`, `#[param(default = expr)]` | field | optional, with `Default::default()` or `expr` |
 //! | `#[param(nested)]` | field | a `Chain` written as an operator list (read with the caller's registry) |
+//! | `#[param(positive)]`, `#[param(non_negative)]` | field | domain `> 0`, `≥ 0` |
+//! | `#[param(gt = a, le = b)]` (and `ge`, `lt`) | field | bounds; `a`, `b` are numbers or other fields (`gt = self.focal_length`) |
+//! | `#[param(finite)]` | field | finite (implied for `f64`, `Option<f64>`, `Vec<f64>`, `[f64; N]`) |
+//!
+//! The operator type and its construction are given by `impl Build for Spec` (cov-core),
+//! never guessed from names. The derive also gives the spec one constant per field,
+//! `Spec::FIELD_NAME` (a `cov_core::Param`), through which code that reports a
+//! parameter names it.
 
 use proc_macro::TokenStream;
 use proc_macro2::TokenStream as Tokens;
 use quote::{format_ident, quote};
-use syn::{Data, DeriveInput, Expr, Fields, Ident, LitStr, Path, spanned::Spanned};
+use syn::{Data, DeriveInput, Expr, Fields, Ident, LitStr, spanned::Spanned};
 
 /// Derives `cov_core::OperatorSpec` for a struct of named parameters.
 #[proc_macro_derive(OperatorSpec, attributes(operator, param))]
@@ -58,6 +65,85 @@ struct FieldSpec {
     doc: String,
     default: Option<Option<Expr>>,
     nested: bool,
+    /// Declared bounds: (`>`, `≥`, `<` or `≤`, the bound).
+    bounds: Vec<(&'static str, Expr)>,
+    /// Checked at all: a declared domain, or a float type.
+    checked: bool,
+}
+
+/// `0` as `0.0`: bounds are compared as f64.
+fn as_float(e: Expr) -> Expr {
+    match &e {
+        Expr::Lit(syn::ExprLit {
+            lit: syn::Lit::Int(i),
+            ..
+        }) => {
+            let f = syn::LitFloat::new(&format!("{}.0", i.base10_digits()), i.span());
+            syn::parse_quote!(#f)
+        }
+        Expr::Unary(u) if matches!(u.op, syn::UnOp::Neg(_)) => {
+            let inner = as_float((*u.expr).clone());
+            syn::parse_quote!(-#inner)
+        }
+        _ => e,
+    }
+}
+
+/// A bound as the docs and messages show it: `self.` dropped, `1.0` as `1`, π by name.
+fn bound_text(e: &Expr) -> String {
+    let t = quote!(#e)
+        .to_string()
+        .replace(" . ", ".")
+        .replace(" :: ", "::")
+        .replace("- ", "-");
+    let t = t.replace("self.", "").replace("crate::", "");
+    let t = match t.strip_prefix("f64::from(").and_then(|i| i.strip_suffix(')')) {
+        Some(inner) => inner.to_string(),
+        None => t,
+    };
+    let t = match t.rsplit("::").next() {
+        Some("PI") => "π".to_string(),
+        _ => t,
+    };
+    match t.strip_suffix(".0") {
+        Some(n) if n.trim_start_matches('-').chars().all(|c| c.is_ascii_digit()) => n.to_string(),
+        _ => t,
+    }
+}
+
+/// Whether a bound is a number written in the source (else its value is shown too).
+fn is_literal(e: &Expr) -> bool {
+    match e {
+        Expr::Lit(_) => true,
+        Expr::Unary(u) => is_literal(&u.expr),
+        _ => false,
+    }
+}
+
+/// The domain in words: `> 0`, `in (0, 1]`, `finite`.
+fn domain_text(f: &FieldSpec) -> String {
+    if !f.checked {
+        return String::new();
+    }
+    let lower = f.bounds.iter().find(|(k, _)| *k == ">" || *k == "≥");
+    let upper = f.bounds.iter().find(|(k, _)| *k == "<" || *k == "≤");
+    match (lower, upper) {
+        (Some((lk, l)), Some((uk, u))) => format!(
+            "in {}{}, {}{}",
+            if *lk == ">" { "(" } else { "[" },
+            bound_text(l),
+            bound_text(u),
+            if *uk == "<" { ")" } else { "]" }
+        ),
+        (Some((k, b)), None) | (None, Some((k, b))) => format!("{k} {}", bound_text(b)),
+        (None, None) => "finite".to_string(),
+    }
+}
+
+/// Types checked for finiteness without a declared domain.
+fn is_float(ty: &syn::Type) -> bool {
+    let t = quote!(#ty).to_string().replace(' ', "");
+    matches!(t.as_str(), "f64" | "Option<f64>" | "Vec<f64>") || (t.starts_with("[f64;") && t.ends_with(']'))
 }
 
 fn doc_of(attrs: &[syn::Attribute]) -> String {
@@ -80,8 +166,7 @@ fn expand(input: &DeriveInput) -> syn::Result<Tokens> {
     let ty = &input.ident;
     let base = ty.to_string();
     let base = base.strip_suffix("Spec").unwrap_or(&base).to_string();
-    let mut name = base.clone();
-    let mut op: Option<Path> = None;
+    let mut name = base;
     let mut summary: Option<String> = None;
     for a in &input.attrs {
         if !a.path().is_ident("operator") {
@@ -91,11 +176,13 @@ fn expand(input: &DeriveInput) -> syn::Result<Tokens> {
             if m.path.is_ident("name") {
                 name = m.value()?.parse::<LitStr>()?.value();
             } else if m.path.is_ident("op") {
-                op = Some(m.value()?.parse::<Path>()?);
+                return Err(m.error(
+                    "`op` is not needed: name the operator type in `impl Build for ThisSpec { type Op = YourOperator; … }`",
+                ));
             } else if m.path.is_ident("summary") {
                 summary = Some(m.value()?.parse::<LitStr>()?.value());
             } else {
-                return Err(m.error("expected `name`, `op` or `summary`"));
+                return Err(m.error("expected `name` or `summary`"));
             }
             Ok(())
         })?;
@@ -106,13 +193,6 @@ fn expand(input: &DeriveInput) -> syn::Result<Tokens> {
             "#[derive(OperatorSpec)] needs #[operator(summary = \"…\")]",
         )
     })?;
-    let op = match op {
-        Some(p) => p,
-        None => {
-            let id = format_ident!("{}", base);
-            syn::parse_quote!(#id)
-        }
-    };
     let Data::Struct(data) = &input.data else {
         return Err(syn::Error::new(input.span(), "OperatorSpec derives on structs"));
     };
@@ -135,6 +215,8 @@ fn expand(input: &DeriveInput) -> syn::Result<Tokens> {
         let mut unit = String::new();
         let mut default = None;
         let mut nested = false;
+        let mut bounds = Vec::new();
+        let mut finite = false;
         for a in &f.attrs {
             if !a.path().is_ident("param") {
                 continue;
@@ -150,13 +232,37 @@ fn expand(input: &DeriveInput) -> syn::Result<Tokens> {
                     }
                 } else if m.path.is_ident("nested") {
                     nested = true;
+                } else if m.path.is_ident("finite") {
+                    finite = true;
+                } else if let Some(k) = ["gt", "ge", "lt", "le", "positive", "non_negative"]
+                    .iter()
+                    .position(|k| m.path.is_ident(k))
+                {
+                    let kind = [">", "≥", "<", "≤", ">", "≥"][k];
+                    let lower = kind == ">" || kind == "≥";
+                    if bounds.iter().any(|(b, _)| (*b == ">" || *b == "≥") == lower) {
+                        return Err(m.error(if lower {
+                            "a second lower bound: give one of `positive`, `non_negative`, `gt`, `ge`"
+                        } else {
+                            "a second upper bound: give one of `lt`, `le`"
+                        }));
+                    }
+                    let e = if k >= 4 {
+                        syn::parse_quote!(0.0)
+                    } else {
+                        as_float(m.value()?.parse::<Expr>()?)
+                    };
+                    bounds.push((kind, e));
                 } else {
-                    return Err(m.error("expected `unit`, `default` or `nested`"));
+                    return Err(m.error(
+                        "expected `unit`, `default`, `nested`, `finite`, `positive`, `non_negative`, `gt`, `ge`, `lt` or `le`",
+                    ));
                 }
                 Ok(())
             })?;
         }
         let name = ident.to_string().trim_start_matches("r#").to_string();
+        let checked = finite || !bounds.is_empty() || is_float(&f.ty);
         specs.push(FieldSpec {
             ident,
             ty: f.ty.clone(),
@@ -165,14 +271,25 @@ fn expand(input: &DeriveInput) -> syn::Result<Tokens> {
             doc: doc_of(&f.attrs),
             default,
             nested,
+            bounds,
+            checked,
         });
     }
 
     let core = core_path();
     let serde = quote!(#core::__serde);
     let names: Vec<&String> = specs.iter().map(|f| &f.name).collect();
-    let params = specs.iter().map(|f| {
+    let consts: Vec<Ident> = specs
+        .iter()
+        .map(|f| format_ident!("{}", f.name.to_uppercase()))
+        .collect();
+    let vis = &input.vis;
+    let params = specs.iter().zip(&consts).map(|(f, c)| {
         let (n, u, d) = (&f.name, &f.unit, &f.doc);
+        let domain = domain_text(f);
+        let what = format!(
+            "The parameter `{n}` of `{name}`: its name, unit, default and domain, for errors that report it."
+        );
         let def = match &f.default {
             None => quote!(::core::option::Option::None),
             Some(None) => quote!(::core::option::Option::Some(#core::spec::OPTIONAL)),
@@ -181,8 +298,42 @@ fn expand(input: &DeriveInput) -> syn::Result<Tokens> {
                 quote!(::core::option::Option::Some(#s))
             }
         };
-        quote!(#core::Param { name: #n, unit: #u, doc: #d, default: #def })
+        quote! {
+            #[doc = #what]
+            #vis const #c: #core::Param = #core::Param {
+                operator: #name, name: #n, unit: #u, doc: #d, default: #def, domain: #domain,
+            };
+        }
     });
+    let checks = specs
+        .iter()
+        .zip(&consts)
+        .filter(|(f, _)| f.checked)
+        .map(|(f, c)| {
+            let id = &f.ident;
+            let conds = f.bounds.iter().map(|(k, b)| match *k {
+                ">" => quote!(__v > (#b)),
+                "≥" => quote!(__v >= (#b)),
+                "<" => quote!(__v < (#b)),
+                _ => quote!(__v <= (#b)),
+            });
+            let mut fmt = format!("must be {}", domain_text(f));
+            let mut args = Vec::new();
+            for (_, b) in &f.bounds {
+                if !is_literal(b) {
+                    fmt.push_str(&format!(" ({} = {{}})", bound_text(b)));
+                    args.push(b.clone());
+                }
+            }
+            quote! {
+                #core::ParamValue::check_param(
+                    &self.#id,
+                    &#ty::#c,
+                    |__v: f64| true #(&& #conds)*,
+                    || ::std::format!(#fmt #(, #args)*),
+                )?;
+            }
+        });
     let slots: Vec<Ident> = specs.iter().map(|f| format_ident!("__{}", f.ident)).collect();
     let decls = specs.iter().zip(&slots).map(|(f, s)| {
         let t = &f.ty;
@@ -227,14 +378,21 @@ fn expand(input: &DeriveInput) -> syn::Result<Tokens> {
     };
     let expecting = format!("the parameters of `{name}`");
     Ok(quote! {
+        impl #ty {
+            #(#params)*
+        }
+
         impl #core::OperatorSpec for #ty {
             const NAME: &'static str = #name;
             const SUMMARY: &'static str = #summary;
-            const PARAMS: &'static [#core::Param] = &[#(#params),*];
-            type Op = #op;
+            const PARAMS: &'static [#core::Param] = &[#(#ty::#consts),*];
 
-            fn build(self) -> ::core::result::Result<#op, #core::CovError> {
-                <#op as ::core::convert::TryFrom<#ty>>::try_from(self)
+            #[inline]
+            // `lo < v && v <= hi` is written as declared; the message says the same.
+            #[allow(clippy::manual_range_contains)]
+            fn check(&self) -> ::core::result::Result<(), #core::CovError> {
+                #(#checks)*
+                ::core::result::Result::Ok(())
             }
 
             fn deserialize_in<'de, __D: #serde::Deserializer<'de>, __R: #core::OperatorReader>(

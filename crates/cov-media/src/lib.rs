@@ -37,16 +37,16 @@
 //! Parameters, as written in a path file (`covtrace list` prints the same):
 //!
 //! <!-- parameters: generated from the specs (`COVTRACE_BLESS=1 cargo test --test param_tables`) -->
-//! | operator | parameter | unit | default | meaning |
-//! |---|---|---|---|---|
-//! | `Absorption` | `length` | m | required | Length of the segment, ≥ 0. |
-//! |  | `hessian` | 1/m³ | required | Hessian of σ_t across the ray: `[hxx]` or `[hxx, hxy, hyy]`. |
-//! | `Segment` | `length` | m | required | Length of the segment, ≥ 0. |
-//! |  | `hessian` | 1/m³ | required | Hessian of σ_t across the ray: `[hxx]` or `[hxx, hxy, hyy]`. |
-//! | `Scatter` | `angle` | rad | required | Scattering angle, in [0, π]. |
-//! |  | `phase` | – | required | Phase function: `HenyeyGreenstein(g)` or `Tabulated(angles, values)`. |
-//! |  | `fit` | – | optional | How the phase lobe is fitted: `Moment` (default) or `Curvature`. |
-//! |  | `azimuth` | rad | optional | Frame rotation into the scattering plane (3D). |
+//! | operator | parameter | unit | default | domain | meaning |
+//! |---|---|---|---|---|---|
+//! | `Absorption` | `length` | m | required | ≥ 0 | Length of the segment. |
+//! |  | `hessian` | 1/m³ | required | finite | Hessian of σ_t across the ray: `[hxx]` or `[hxx, hxy, hyy]`. |
+//! | `Segment` | `length` | m | required | ≥ 0 | Length of the segment. |
+//! |  | `hessian` | 1/m³ | required | finite | Hessian of σ_t across the ray: `[hxx]` or `[hxx, hxy, hyy]`. |
+//! | `Scatter` | `angle` | rad | required | in [0, π] | Scattering angle. |
+//! |  | `phase` | – | required | – | Phase function: `HenyeyGreenstein(g)` or `Tabulated(angles, values)`. |
+//! |  | `fit` | – | optional | – | How the phase lobe is fitted: `Moment` (default) or `Curvature`. |
+//! |  | `azimuth` | rad | optional | finite | Frame rotation into the scattering plane (3D). |
 //! <!-- end of parameters -->
 //!
 //! **Worked example**: fog with `H = 0.5 /m³` over `L = 2 m`: `Q_xx = L·H = 1`, `Q_xu = 1`,
@@ -88,7 +88,7 @@ pub mod spec;
 
 use std::f64::consts::{FRAC_PI_2, PI};
 
-use cov_core::{Axis, AxisSet, CovError, FOUR_PI_SQ, Operator, Spectrum, Turn};
+use cov_core::{Axis, AxisSet, CovError, FOUR_PI_SQ, Operator, OperatorSpec, Spectrum, Turn, arg};
 
 /// Absorption over a segment of a heterogeneous medium, as a window at its start.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -106,14 +106,11 @@ impl Absorption {
     /// # Errors
     /// Negative or non-finite length, non-finite Hessian.
     pub fn new(length: f64, hessian: [f64; 3]) -> Result<Self, CovError> {
-        CovError::require_non_negative(Self::NAME, "length", length)?;
-        for (name, v) in ["hxx", "hxy", "hyy"].iter().zip(hessian) {
-            CovError::require_finite(Self::NAME, name, v)?;
-        }
-        Ok(Absorption {
+        spec::AbsorptionSpec {
             length,
-            h: psd_part(hessian),
-        })
+            hessian: hessian.to_vec(),
+        }
+        .build()
     }
 
     /// The PSD part of the Hessian actually used.
@@ -189,9 +186,11 @@ impl Segment {
     /// # Errors
     /// As [`Absorption::new`].
     pub fn new(length: f64, hessian: [f64; 3]) -> Result<Self, CovError> {
-        Ok(Segment {
-            absorption: Absorption::new(length, hessian)?,
-        })
+        spec::SegmentSpec {
+            length,
+            hessian: hessian.to_vec(),
+        }
+        .build()
     }
 }
 
@@ -243,14 +242,9 @@ impl Phase {
     /// or with non-positive or non-finite values.
     pub fn validated(self) -> Result<Phase, CovError> {
         match &self {
-            Phase::HenyeyGreenstein { g } => {
-                CovError::require_range(
-                    "HenyeyGreenstein",
-                    "g",
-                    *g,
-                    |g| g > -1.0 && g < 1.0,
-                    "must be in (−1, 1)",
-                )?;
+            &Phase::HenyeyGreenstein { g } => {
+                arg!("HenyeyGreenstein", g)
+                    .require(|g| g > -1.0 && g < 1.0, || "must be in (−1, 1)".into())?;
             }
             Phase::Tabulated { angles, values } => {
                 if angles.len() < 3 || angles.len() != values.len() {
@@ -260,16 +254,11 @@ impl Phase {
                         got: format!("{} angles, {} values", angles.len(), values.len()),
                     });
                 }
-                for (k, (a, v)) in angles.iter().zip(values).enumerate() {
-                    CovError::require_finite("Tabulated", &format!("angles[{k}]"), *a)?;
-                    CovError::require_positive("Tabulated", &format!("values[{k}]"), *v)?;
-                    if k > 0 && *a <= angles[k - 1] {
-                        return Err(CovError::OutOfRange {
-                            operator: "Tabulated".into(),
-                            parameter: format!("angles[{k}]"),
-                            value: *a,
-                            expected: "strictly increasing angles".into(),
-                        });
+                for k in 0..angles.len() {
+                    arg!("Tabulated", angles[k]).finite()?;
+                    arg!("Tabulated", values[k]).positive()?;
+                    if k > 0 && angles[k] <= angles[k - 1] {
+                        return Err(arg!("Tabulated", angles[k]).error("strictly increasing angles"));
                     }
                 }
             }
@@ -364,14 +353,18 @@ impl Scatter {
     /// # Errors
     /// `angle` outside [0, π], non-finite `azimuth`, invalid phase function.
     pub fn new(angle: f64, phase: Phase, fit: Fit, azimuth: f64) -> Result<Self, CovError> {
-        CovError::require_range(
-            Self::NAME,
-            "angle",
+        spec::ScatterSpec {
             angle,
-            |a| (0.0..=PI).contains(&a),
-            "must be in [0, π]",
-        )?;
-        let azimuth = Turn::new(Self::NAME, "azimuth", azimuth)?;
+            phase,
+            fit: Some(fit),
+            azimuth: Some(azimuth),
+        }
+        .build()
+    }
+
+    /// From parameters checked by the spec.
+    fn checked(angle: f64, phase: Phase, fit: Fit, azimuth: f64) -> Result<Self, CovError> {
+        let azimuth = Turn::new(spec::ScatterSpec::AZIMUTH.of(azimuth))?;
         let phase = phase.validated()?;
         let var = match fit {
             Fit::Curvature => {

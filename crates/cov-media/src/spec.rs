@@ -1,38 +1,46 @@
 //! RON parameters of the media operators.
 
-use cov_core::CovError;
-use cov_core::{OperatorSpec, Registrar};
+use cov_core::{Build, Checked, CovError, OperatorSpec, Param, Registrar};
 
-use crate::{Absorption, Fit, Phase, Scatter, Segment};
+use crate::{Absorption, Fit, Phase, Scatter, Segment, psd_part};
 
-fn hessian(op: &str, h: &[f64]) -> Result<[f64; 3], CovError> {
+/// `[hxx]` or `[hxx, hxy, hyy]` as `[hxx, hxy, hyy]`; `p` is the parameter.
+fn hessian(p: &Param, h: &[f64]) -> Result<[f64; 3], CovError> {
     match h {
         [a] => Ok([*a, 0.0, 0.0]),
         [a, b, c] => Ok([*a, *b, *c]),
         _ => Err(CovError::Shape {
-            what: format!("{op}: hessian"),
+            what: format!("{}: {}", p.operator, p.name),
             expected: "[hxx] or [hxx, hxy, hyy]".into(),
             got: format!("{} numbers", h.len()),
         }),
     }
 }
 
+/// The absorption of a segment of checked `length` with the Hessian `h`, the parameter `p`.
+fn absorption(length: f64, p: &Param, h: &[f64]) -> Result<Absorption, CovError> {
+    Ok(Absorption {
+        length,
+        h: psd_part(hessian(p, h)?),
+    })
+}
+
 /// `Absorption(length: 2.0, hessian: [0.5])`.
 #[derive(Debug, OperatorSpec)]
 #[operator(summary = "absorption across a heterogeneous segment (a window)")]
 pub struct AbsorptionSpec {
-    /// Length of the segment, ≥ 0.
-    #[param(unit = "m")]
+    /// Length of the segment.
+    #[param(unit = "m", non_negative)]
     pub length: f64,
     /// Hessian of σ_t across the ray: `[hxx]` or `[hxx, hxy, hyy]`.
     #[param(unit = "1/m³")]
     pub hessian: Vec<f64>,
 }
 
-impl TryFrom<AbsorptionSpec> for Absorption {
-    type Error = CovError;
-    fn try_from(spec: AbsorptionSpec) -> Result<Absorption, CovError> {
-        Absorption::new(spec.length, hessian(Absorption::NAME, &spec.hessian)?)
+impl Build for AbsorptionSpec {
+    type Op = Absorption;
+    fn make(spec: Checked<Self>) -> Result<Absorption, CovError> {
+        absorption(spec.length, &Self::HESSIAN, &spec.hessian)
     }
 }
 
@@ -40,18 +48,20 @@ impl TryFrom<AbsorptionSpec> for Absorption {
 #[derive(Debug, OperatorSpec)]
 #[operator(summary = "a volumetric segment: absorption then travel")]
 pub struct SegmentSpec {
-    /// Length of the segment, ≥ 0.
-    #[param(unit = "m")]
+    /// Length of the segment.
+    #[param(unit = "m", non_negative)]
     pub length: f64,
     /// Hessian of σ_t across the ray: `[hxx]` or `[hxx, hxy, hyy]`.
     #[param(unit = "1/m³")]
     pub hessian: Vec<f64>,
 }
 
-impl TryFrom<SegmentSpec> for Segment {
-    type Error = CovError;
-    fn try_from(spec: SegmentSpec) -> Result<Segment, CovError> {
-        Segment::new(spec.length, hessian(Segment::NAME, &spec.hessian)?)
+impl Build for SegmentSpec {
+    type Op = Segment;
+    fn make(spec: Checked<Self>) -> Result<Segment, CovError> {
+        Ok(Segment {
+            absorption: absorption(spec.length, &Self::HESSIAN, &spec.hessian)?,
+        })
     }
 }
 
@@ -59,8 +69,8 @@ impl TryFrom<SegmentSpec> for Segment {
 #[derive(Debug, OperatorSpec)]
 #[operator(summary = "scattering at a point: frame alignment and the phase function lobe")]
 pub struct ScatterSpec {
-    /// Scattering angle, in [0, π].
-    #[param(unit = "rad")]
+    /// Scattering angle.
+    #[param(unit = "rad", ge = 0, le = std::f64::consts::PI)]
     pub angle: f64,
     /// Phase function: `HenyeyGreenstein(g)` or `Tabulated(angles, values)`.
     pub phase: Phase,
@@ -72,10 +82,11 @@ pub struct ScatterSpec {
     pub azimuth: Option<f64>,
 }
 
-impl TryFrom<ScatterSpec> for Scatter {
-    type Error = CovError;
-    fn try_from(spec: ScatterSpec) -> Result<Scatter, CovError> {
-        Scatter::new(
+impl Build for ScatterSpec {
+    type Op = Scatter;
+    fn make(spec: Checked<Self>) -> Result<Scatter, CovError> {
+        let spec = spec.into_inner();
+        Scatter::checked(
             spec.angle,
             spec.phase,
             spec.fit.unwrap_or_default(),

@@ -14,15 +14,15 @@
 //! Parameters, as written in a path file (`covtrace list` prints the same):
 //!
 //! <!-- parameters: generated from the specs (`COVTRACE_BLESS=1 cargo test --test param_tables`) -->
-//! | operator | parameter | unit | default | meaning |
-//! |---|---|---|---|---|
-//! | `Moving` | `velocity` | m/s | required | Velocity in the tangent plane, `[vx]` or `[vx, vy]`, finite. |
-//! |  | `angular` | rad/s | optional | Angular velocity, `[wu]` or `[wu, wv]`. |
-//! |  | `operators` | – | required | The object's static operators, applied in its moving frame. |
-//! | `CameraMotion` | `velocity` | m/s | required | Velocity of the camera, `[vx]` or `[vx, vy]`, finite. |
-//! |  | `angular` | rad/s | optional | Angular velocity of the camera, `[wu]` or `[wu, wv]`. |
-//! | `Shutter` | `duration` | s | required | Exposure, > 0. |
-//! |  | `shape` | – | optional | `Box` (default) or `Gaussian` (std = duration). |
+//! | operator | parameter | unit | default | domain | meaning |
+//! |---|---|---|---|---|---|
+//! | `Moving` | `velocity` | m/s | required | finite | Velocity in the tangent plane, `[vx]` or `[vx, vy]`. |
+//! |  | `angular` | rad/s | optional | finite | Angular velocity, `[wu]` or `[wu, wv]`. |
+//! |  | `operators` | – | required | – | The object's static operators, applied in its moving frame. |
+//! | `CameraMotion` | `velocity` | m/s | required | finite | Velocity of the camera, `[vx]` or `[vx, vy]`. |
+//! |  | `angular` | rad/s | optional | finite | Angular velocity of the camera, `[wu]` or `[wu, wv]`. |
+//! | `Shutter` | `duration` | s | required | > 0 | Exposure. |
+//! |  | `shape` | – | optional | – | `Box` (default) or `Gaussian` (std = duration). |
 //! <!-- end of parameters -->
 //!
 //! All need the time axis (layouts 3 and 5). A zero-length shutter is rejected
@@ -72,7 +72,7 @@
 
 pub mod spec;
 
-use cov_core::{Axis, AxisSet, Chain, CovError, FOUR_PI_SQ, Operator, Spectrum};
+use cov_core::{Axis, AxisSet, Chain, CovError, Operator, OperatorSpec, Spectrum, arg};
 
 /// The frame of an object in motion: linear and angular velocity in the tangent plane.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -92,14 +92,14 @@ impl MotionFrame {
     ///
     /// # Errors
     /// Non-finite components.
-    pub fn for_operator(operator: &str, velocity: [f64; 2], angular: [f64; 2]) -> Result<Self, CovError> {
-        for (name, x) in [
-            ("velocity.x", velocity[0]),
-            ("velocity.y", velocity[1]),
-            ("angular.u", angular[0]),
-            ("angular.v", angular[1]),
-        ] {
-            CovError::require_finite(operator, name, x)?;
+    pub fn for_operator(
+        operator: &'static str,
+        velocity: [f64; 2],
+        angular: [f64; 2],
+    ) -> Result<Self, CovError> {
+        for k in 0..2 {
+            arg!(operator, velocity[k]).finite()?;
+            arg!(operator, angular[k]).finite()?;
         }
         Ok(MotionFrame {
             v: velocity,
@@ -152,10 +152,12 @@ impl Moving {
     /// # Errors
     /// Non-finite velocities.
     pub fn new(velocity: [f64; 2], angular: [f64; 2], operators: Chain) -> Result<Self, CovError> {
-        Ok(Moving {
-            frame: MotionFrame::for_operator(Self::NAME, velocity, angular)?,
+        spec::MovingSpec {
+            velocity: velocity.to_vec(),
+            angular: angular.to_vec(),
             operators,
-        })
+        }
+        .build()
     }
 }
 
@@ -183,9 +185,11 @@ impl CameraMotion {
     /// # Errors
     /// Non-finite velocities.
     pub fn new(velocity: [f64; 2], angular: [f64; 2]) -> Result<Self, CovError> {
-        Ok(CameraMotion {
-            frame: MotionFrame::for_operator(Self::NAME, velocity, angular)?,
-        })
+        spec::CameraMotionSpec {
+            velocity: velocity.to_vec(),
+            angular: angular.to_vec(),
+        }
+        .build()
     }
 }
 
@@ -224,20 +228,11 @@ impl Shutter {
     /// Non-positive or non-finite duration (a zero-length shutter is a static image: trace
     /// without time instead).
     pub fn new(duration: f64, shape: ShutterShape) -> Result<Self, CovError> {
-        CovError::require_positive(Self::NAME, "duration", duration)?;
-        let std = match shape {
-            ShutterShape::Box => duration / 12f64.sqrt(),
-            ShutterShape::Gaussian => duration,
-        };
-        let w = 1.0 / (FOUR_PI_SQ * std * std);
-        CovError::require_range(
-            Self::NAME,
-            "duration",
-            w,
-            f64::is_finite,
-            "too short: 1/(4π² s²) overflows",
-        )?;
-        Ok(Shutter { std, w })
+        spec::ShutterSpec {
+            duration,
+            shape: Some(shape),
+        }
+        .build()
     }
 
     /// Std of the (equivalent) Gaussian time window (s).

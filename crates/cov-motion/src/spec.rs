@@ -1,17 +1,17 @@
 //! RON parameters of the motion operators.
 
-use cov_core::CovError;
-use cov_core::{Chain, OperatorSpec, Registrar};
+use cov_core::{Build, Chain, Checked, CovError, FOUR_PI_SQ, OperatorSpec, Param, Registrar};
 
-use crate::{CameraMotion, Moving, Shutter, ShutterShape};
+use crate::{CameraMotion, MotionFrame, Moving, Shutter, ShutterShape};
 
-fn pad(op: &str, name: &str, v: &[f64]) -> Result<[f64; 2], CovError> {
+/// `[]`, `[a]` or `[a, b]` as `[a, b]`; `p` is the parameter.
+fn pad(p: &Param, v: &[f64]) -> Result<[f64; 2], CovError> {
     match v {
         [] => Ok([0.0, 0.0]),
         [a] => Ok([*a, 0.0]),
         [a, b] => Ok([*a, *b]),
         _ => Err(CovError::Shape {
-            what: format!("{op}: {name}"),
+            what: format!("{}: {}", p.operator, p.name),
             expected: "1 or 2 components".into(),
             got: format!("{}", v.len()),
         }),
@@ -22,7 +22,7 @@ fn pad(op: &str, name: &str, v: &[f64]) -> Result<[f64; 2], CovError> {
 #[derive(Debug, OperatorSpec)]
 #[operator(summary = "an object in motion: its operators applied in its moving frame")]
 pub struct MovingSpec {
-    /// Velocity in the tangent plane, `[vx]` or `[vx, vy]`, finite.
+    /// Velocity in the tangent plane, `[vx]` or `[vx, vy]`.
     #[param(unit = "m/s")]
     pub velocity: Vec<f64>,
     /// Angular velocity, `[wu]` or `[wu, wv]`.
@@ -33,12 +33,17 @@ pub struct MovingSpec {
     pub operators: Chain,
 }
 
-impl TryFrom<MovingSpec> for Moving {
-    type Error = CovError;
-    fn try_from(spec: MovingSpec) -> Result<Moving, CovError> {
-        let v = pad(Moving::NAME, "velocity", &spec.velocity)?;
-        let w = pad(Moving::NAME, "angular", &spec.angular)?;
-        Moving::new(v, w, spec.operators)
+impl Build for MovingSpec {
+    type Op = Moving;
+    fn make(spec: Checked<Self>) -> Result<Moving, CovError> {
+        let spec = spec.into_inner();
+        Ok(Moving {
+            frame: MotionFrame {
+                v: pad(&Self::VELOCITY, &spec.velocity)?,
+                w: pad(&Self::ANGULAR, &spec.angular)?,
+            },
+            operators: spec.operators,
+        })
     }
 }
 
@@ -46,7 +51,7 @@ impl TryFrom<MovingSpec> for Moving {
 #[derive(Debug, OperatorSpec)]
 #[operator(summary = "the camera moves: the rest of the path in its frame")]
 pub struct CameraMotionSpec {
-    /// Velocity of the camera, `[vx]` or `[vx, vy]`, finite.
+    /// Velocity of the camera, `[vx]` or `[vx, vy]`.
     #[param(unit = "m/s")]
     pub velocity: Vec<f64>,
     /// Angular velocity of the camera, `[wu]` or `[wu, wv]`.
@@ -54,13 +59,15 @@ pub struct CameraMotionSpec {
     pub angular: Vec<f64>,
 }
 
-impl TryFrom<CameraMotionSpec> for CameraMotion {
-    type Error = CovError;
-    fn try_from(spec: CameraMotionSpec) -> Result<CameraMotion, CovError> {
-        CameraMotion::new(
-            pad(CameraMotion::NAME, "velocity", &spec.velocity)?,
-            pad(CameraMotion::NAME, "angular", &spec.angular)?,
-        )
+impl Build for CameraMotionSpec {
+    type Op = CameraMotion;
+    fn make(spec: Checked<Self>) -> Result<CameraMotion, CovError> {
+        Ok(CameraMotion {
+            frame: MotionFrame {
+                v: pad(&Self::VELOCITY, &spec.velocity)?,
+                w: pad(&Self::ANGULAR, &spec.angular)?,
+            },
+        })
     }
 }
 
@@ -68,18 +75,26 @@ impl TryFrom<CameraMotionSpec> for CameraMotion {
 #[derive(Debug, OperatorSpec)]
 #[operator(summary = "the shutter as a time window")]
 pub struct ShutterSpec {
-    /// Exposure, > 0.
-    #[param(unit = "s")]
+    /// Exposure.
+    #[param(unit = "s", positive)]
     pub duration: f64,
     /// `Box` (default) or `Gaussian` (std = duration).
     #[param(default)]
     pub shape: Option<ShutterShape>,
 }
 
-impl TryFrom<ShutterSpec> for Shutter {
-    type Error = CovError;
-    fn try_from(spec: ShutterSpec) -> Result<Shutter, CovError> {
-        Shutter::new(spec.duration, spec.shape.unwrap_or(ShutterShape::Box))
+impl Build for ShutterSpec {
+    type Op = Shutter;
+    fn make(spec: Checked<Self>) -> Result<Shutter, CovError> {
+        let std = match spec.shape.unwrap_or(ShutterShape::Box) {
+            ShutterShape::Box => spec.duration / 12f64.sqrt(),
+            ShutterShape::Gaussian => spec.duration,
+        };
+        let w = 1.0 / (FOUR_PI_SQ * std * std);
+        if !w.is_finite() {
+            return Err(Self::DURATION.error(spec.duration, "too short: 1/(4π² s²) overflows"));
+        }
+        Ok(Shutter { std, w })
     }
 }
 

@@ -8,18 +8,18 @@
 //! Parameters, as written in a path file (`covtrace list` prints the same):
 //!
 //! <!-- parameters: generated from the specs (`COVTRACE_BLESS=1 cargo test --test param_tables`) -->
-//! | operator | parameter | unit | default | meaning |
-//! |---|---|---|---|---|
-//! | `Window` | `std_x` | m | required | Std along x, > 0. |
-//! |  | `std_y` | m | optional | Std along y, > 0 (`std_x` when left out). |
-//! | `BlockerEdge` | `distance` | m | required | Distance from the ray to the nearest blocker edge, > 0. |
-//! | `Texture` | `feature` | m | optional | Size of the texture's features (a Gaussian bump of that std), > 0; or give the spectrum `sxx`, `sxy`, `syy`. |
-//! |  | `sxx` | (cycles/m)² | optional | Spectrum covariance xx, ≥ 0. |
-//! |  | `sxy` | (cycles/m)² | optional | Spectrum covariance xy, `\|sxy\| ≤ √(sxx·syy)` (0 when left out). |
-//! |  | `syy` | (cycles/m)² | optional | Spectrum covariance yy, ≥ 0 (`sxx` when left out). |
-//! | `ThickOccluder` | `depth` | m | required | Depth of the occluder along the ray, ≥ 0. |
-//! |  | `slices` | – | required | Number of slices, 1 to 10000. |
-//! |  | `std` | m | required | Window std of each slice, > 0. |
+//! | operator | parameter | unit | default | domain | meaning |
+//! |---|---|---|---|---|---|
+//! | `Window` | `std_x` | m | required | > 0 | Std along x. |
+//! |  | `std_y` | m | optional | > 0 | Std along y (`std_x` when left out). |
+//! | `BlockerEdge` | `distance` | m | required | > 0 | Distance from the ray to the nearest blocker edge. |
+//! | `Texture` | `feature` | m | optional | > 0 | Size of the texture's features (a Gaussian bump of that std); or give the spectrum `sxx`, `sxy`, `syy`. |
+//! |  | `sxx` | (cycles/m)² | optional | ≥ 0 | Spectrum covariance xx. |
+//! |  | `sxy` | (cycles/m)² | optional | finite | Spectrum covariance xy, `\|sxy\| ≤ √(sxx·syy)` (0 when left out). |
+//! |  | `syy` | (cycles/m)² | optional | ≥ 0 | Spectrum covariance yy (`sxx` when left out). |
+//! | `ThickOccluder` | `depth` | m | required | ≥ 0 | Depth of the occluder along the ray. |
+//! |  | `slices` | – | required | in [1, 10000] | Number of slices. (At most 10⁴: each slice is a window and a travel, so this bounds the work of one operator; finer slicing changes nothing measurable, since the slices' windows add up to the occluder's.) |
+//! |  | `std` | m | required | > 0 | Window std of each slice. |
 //! <!-- end of parameters -->
 //!
 //! The **blocker-edge rule** (the course's "largest unoccluded disk"): the local window
@@ -64,27 +64,22 @@
 
 pub mod spec;
 
-use cov_core::{Axis, CovError, FOUR_PI_SQ, Operator, Spectrum};
+use cov_core::{Axis, CovError, FOUR_PI_SQ, Operator, OperatorSpec, Param, Spectrum};
 
+/// The spectrum variance `1/(4π² s²)` of a window of std `s` (checked > 0 by the spec),
+/// the parameter `p`.
 #[inline]
-fn window_var(op: &str, name: &str, std: f64) -> Result<f64, CovError> {
-    CovError::require_positive(op, name, std)?;
+fn window_var(p: &Param, std: f64) -> Result<f64, CovError> {
     let w = 1.0 / (FOUR_PI_SQ * std * std);
+    if w.is_finite() {
+        return Ok(w);
+    }
     // Reported on the user's std, not on the derived variance (which is what overflows).
-    CovError::require_range(
-        op,
-        name,
+    Err(p.error(
         std,
-        |_| w.is_finite(),
         "too small: the window's spectrum variance 1/(4π² s²) overflows f64 (s must be above about 1e-153 m)",
-    )?;
-    Ok(w)
+    ))
 }
-
-/// Most slices a [`ThickOccluder`] is cut into: each slice is a window and a travel, so
-/// this bounds the work of one operator (finer slicing changes nothing measurable: the
-/// slices' windows add up to the occluder's).
-pub const MAX_SLICES: u32 = 10_000;
 
 /// A Gaussian window across the ray: `w(x, y) = exp(−x²/2s_x² − y²/2s_y²)`.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -103,10 +98,11 @@ impl Window {
     /// Non-finite or non-positive std, or one so small the spectrum overflows.
     #[inline]
     pub fn new(std_x: f64, std_y: f64) -> Result<Self, CovError> {
-        Ok(Window {
-            wx: window_var(Self::NAME, "std_x", std_x)?,
-            wy: window_var(Self::NAME, "std_y", std_y)?,
-        })
+        spec::WindowSpec {
+            std_x,
+            std_y: Some(std_y),
+        }
+        .build()
     }
 
     /// The same std on both axes.
@@ -157,11 +153,7 @@ impl BlockerEdge {
     /// # Errors
     /// Non-finite or non-positive `distance`.
     pub fn new(distance: f64) -> Result<Self, CovError> {
-        let w = window_var(Self::NAME, "distance", distance)?;
-        Ok(BlockerEdge {
-            window: Window { wx: w, wy: w },
-            distance,
-        })
+        spec::BlockerEdgeSpec { distance }.build()
     }
 
     /// The distance to the edge (m).
@@ -192,18 +184,13 @@ impl Texture {
     /// # Errors
     /// Non-finite entries, or a matrix that is not PSD.
     pub fn new(sxx: f64, sxy: f64, syy: f64) -> Result<Self, CovError> {
-        CovError::require_non_negative(Self::NAME, "sxx", sxx)?;
-        CovError::require_non_negative(Self::NAME, "syy", syy)?;
-        CovError::require_finite(Self::NAME, "sxy", sxy)?;
-        if sxy * sxy > sxx * syy * (1.0 + 1e-12) {
-            return Err(CovError::OutOfRange {
-                operator: Self::NAME.into(),
-                parameter: "sxy".into(),
-                value: sxy,
-                expected: format!("|sxy| ≤ √(sxx·syy) = {}", (sxx * syy).sqrt()),
-            });
+        spec::TextureSpec {
+            feature: None,
+            sxx: Some(sxx),
+            sxy: Some(sxy),
+            syy: Some(syy),
         }
-        Ok(Texture { s: [sxx, sxy, syy] })
+        .build()
     }
 
     /// A texture whose features are Gaussian bumps of std `feature` (m), isotropic.
@@ -211,8 +198,13 @@ impl Texture {
     /// # Errors
     /// Non-finite or non-positive `feature`.
     pub fn gaussian_feature(feature: f64) -> Result<Self, CovError> {
-        let w = window_var(Self::NAME, "feature", feature)?;
-        Self::new(w, 0.0, w)
+        spec::TextureSpec {
+            feature: Some(feature),
+            sxx: None,
+            sxy: None,
+            syy: None,
+        }
+        .build()
     }
 
     /// The spectrum of a texture `A` (a reflectance factor) computed from its local
@@ -242,8 +234,8 @@ impl Texture {
     /// Non-finite or negative `mean_sq`, a non-finite `mean`, gradient moments that are not
     /// finite or not PSD.
     pub fn from_moments(mean: f64, mean_sq: f64, grad: [f64; 3]) -> Result<Self, CovError> {
-        CovError::require_finite(Self::NAME, "mean", mean)?;
-        CovError::require_non_negative(Self::NAME, "mean_sq", mean_sq)?;
+        cov_core::arg!(Self::NAME, mean).finite()?;
+        cov_core::arg!(Self::NAME, mean_sq).non_negative()?;
         let [gxx, gxy, gyy] = grad;
         // The same checks as `new`, on the gradient moments.
         Self::new(gxx, gxy, gyy)?;
@@ -288,25 +280,7 @@ impl ThickOccluder {
     /// # Errors
     /// Negative or non-finite `depth`, `slices == 0`, invalid `std`.
     pub fn new(depth: f64, slices: u32, std: f64) -> Result<Self, CovError> {
-        CovError::require_non_negative(Self::NAME, "depth", depth)?;
-        if slices == 0 || slices > MAX_SLICES {
-            return Err(CovError::OutOfRange {
-                operator: Self::NAME.into(),
-                parameter: "slices".into(),
-                value: f64::from(slices),
-                expected: if slices == 0 {
-                    "must be ≥ 1".into()
-                } else {
-                    format!("must be at most {MAX_SLICES}")
-                },
-            });
-        }
-        let w = window_var(Self::NAME, "std", std)?;
-        Ok(ThickOccluder {
-            window: Window { wx: w, wy: w },
-            step: depth / f64::from(slices),
-            slices,
-        })
+        spec::ThickOccluderSpec { depth, slices, std }.build()
     }
 }
 

@@ -1,26 +1,32 @@
 //! RON parameters of the occlusion operators.
 
-use cov_core::CovError;
-use cov_core::{OperatorSpec, Registrar};
+use cov_core::{Build, Checked, CovError, OperatorSpec, Registrar};
 
-use crate::{BlockerEdge, Texture, ThickOccluder, Window};
+use crate::{BlockerEdge, Texture, ThickOccluder, Window, window_var};
 
 /// `Window(std_x: 0.1)` or `Window(std_x: 0.1, std_y: 0.2)`.
 #[derive(Debug, OperatorSpec)]
 #[operator(summary = "Gaussian window across the ray (an occluder's aperture)")]
 pub struct WindowSpec {
-    /// Std along x, > 0.
-    #[param(unit = "m")]
+    /// Std along x.
+    #[param(unit = "m", positive)]
     pub std_x: f64,
-    /// Std along y, > 0 (`std_x` when left out).
-    #[param(unit = "m", default)]
+    /// Std along y (`std_x` when left out).
+    #[param(unit = "m", default, positive)]
     pub std_y: Option<f64>,
 }
 
-impl TryFrom<WindowSpec> for Window {
-    type Error = CovError;
-    fn try_from(spec: WindowSpec) -> Result<Window, CovError> {
-        Window::new(spec.std_x, spec.std_y.unwrap_or(spec.std_x))
+impl Build for WindowSpec {
+    type Op = Window;
+    #[inline]
+    fn make(spec: Checked<Self>) -> Result<Window, CovError> {
+        Ok(Window {
+            wx: window_var(&WindowSpec::STD_X, spec.std_x)?,
+            wy: match spec.std_y {
+                Some(s) => window_var(&WindowSpec::STD_Y, s)?,
+                None => window_var(&WindowSpec::STD_X, spec.std_x)?,
+            },
+        })
     }
 }
 
@@ -28,15 +34,19 @@ impl TryFrom<WindowSpec> for Window {
 #[derive(Debug, OperatorSpec)]
 #[operator(summary = "blocker edge near the ray (largest unoccluded disk rule)")]
 pub struct BlockerEdgeSpec {
-    /// Distance from the ray to the nearest blocker edge, > 0.
-    #[param(unit = "m")]
+    /// Distance from the ray to the nearest blocker edge.
+    #[param(unit = "m", positive)]
     pub distance: f64,
 }
 
-impl TryFrom<BlockerEdgeSpec> for BlockerEdge {
-    type Error = CovError;
-    fn try_from(spec: BlockerEdgeSpec) -> Result<BlockerEdge, CovError> {
-        BlockerEdge::new(spec.distance)
+impl Build for BlockerEdgeSpec {
+    type Op = BlockerEdge;
+    fn make(spec: Checked<Self>) -> Result<BlockerEdge, CovError> {
+        let w = window_var(&BlockerEdgeSpec::DISTANCE, spec.distance)?;
+        Ok(BlockerEdge {
+            window: Window { wx: w, wy: w },
+            distance: spec.distance,
+        })
     }
 }
 
@@ -44,33 +54,51 @@ impl TryFrom<BlockerEdgeSpec> for BlockerEdge {
 #[derive(Debug, OperatorSpec)]
 #[operator(summary = "texture variation as a window on position")]
 pub struct TextureSpec {
-    /// Size of the texture's features (a Gaussian bump of that std), > 0; or give the spectrum `sxx`, `sxy`, `syy`.
-    #[param(unit = "m", default)]
+    /// Size of the texture's features (a Gaussian bump of that std); or give the spectrum `sxx`, `sxy`, `syy`.
+    #[param(unit = "m", default, positive)]
     pub feature: Option<f64>,
-    /// Spectrum covariance xx, ≥ 0.
-    #[param(unit = "(cycles/m)²", default)]
+    /// Spectrum covariance xx.
+    #[param(unit = "(cycles/m)²", default, non_negative)]
     pub sxx: Option<f64>,
     /// Spectrum covariance xy, `|sxy| ≤ √(sxx·syy)` (0 when left out).
     #[param(unit = "(cycles/m)²", default)]
     pub sxy: Option<f64>,
-    /// Spectrum covariance yy, ≥ 0 (`sxx` when left out).
-    #[param(unit = "(cycles/m)²", default)]
+    /// Spectrum covariance yy (`sxx` when left out).
+    #[param(unit = "(cycles/m)²", default, non_negative)]
     pub syy: Option<f64>,
 }
 
-impl TryFrom<TextureSpec> for Texture {
-    type Error = CovError;
-    fn try_from(spec: TextureSpec) -> Result<Texture, CovError> {
-        match (spec.feature, spec.sxx) {
-            (Some(f), None) if spec.sxy.is_none() && spec.syy.is_none() => Texture::gaussian_feature(f),
-            (None, Some(sxx)) => Texture::new(sxx, spec.sxy.unwrap_or(0.0), spec.syy.unwrap_or(sxx)),
-            _ => Err(CovError::OutOfRange {
-                operator: "Texture".into(),
-                parameter: "feature / sxx".into(),
-                value: f64::NAN,
-                expected: "give either `feature` or the spectrum `sxx` (with optional `sxy`, `syy`)".into(),
-            }),
+impl Build for TextureSpec {
+    type Op = Texture;
+    #[inline]
+    fn make(spec: Checked<Self>) -> Result<Texture, CovError> {
+        let (sxx, sxy, syy) = match (spec.feature, spec.sxx) {
+            (Some(f), None) if spec.sxy.is_none() && spec.syy.is_none() => {
+                let w = window_var(&TextureSpec::FEATURE, f)?;
+                (w, 0.0, w)
+            }
+            (None, Some(sxx)) => (sxx, spec.sxy.unwrap_or(0.0), spec.syy.unwrap_or(sxx)),
+            _ => {
+                let (f, xx, xy, yy) = (
+                    TextureSpec::FEATURE.name,
+                    TextureSpec::SXX.name,
+                    TextureSpec::SXY.name,
+                    TextureSpec::SYY.name,
+                );
+                return Err(TextureSpec::FEATURE.error(
+                    spec.feature.unwrap_or(f64::NAN),
+                    format!("give either `{f}` or the spectrum `{xx}` (with optional `{xy}`, `{yy}`)"),
+                ));
+            }
+        };
+        // PSD, with a relative tolerance for rounding in the caller's products.
+        if sxy * sxy > sxx * syy * (1.0 + 1e-12) {
+            return Err(TextureSpec::SXY.error(
+                sxy,
+                format!("|sxy| must be ≤ √(sxx·syy) = {}", (sxx * syy).sqrt()),
+            ));
         }
+        Ok(Texture { s: [sxx, sxy, syy] })
     }
 }
 
@@ -78,20 +106,28 @@ impl TryFrom<TextureSpec> for Texture {
 #[derive(Debug, OperatorSpec)]
 #[operator(summary = "an occluder with depth, as slices of windows with travel between")]
 pub struct ThickOccluderSpec {
-    /// Depth of the occluder along the ray, ≥ 0.
-    #[param(unit = "m")]
+    /// Depth of the occluder along the ray.
+    #[param(unit = "m", non_negative)]
     pub depth: f64,
-    /// Number of slices, 1 to 10000.
+    /// Number of slices. (At most 10⁴: each slice is a window and a travel, so this
+    /// bounds the work of one operator; finer slicing changes nothing measurable, since
+    /// the slices' windows add up to the occluder's.)
+    #[param(ge = 1, le = 10_000)]
     pub slices: u32,
-    /// Window std of each slice, > 0.
-    #[param(unit = "m")]
+    /// Window std of each slice.
+    #[param(unit = "m", positive)]
     pub std: f64,
 }
 
-impl TryFrom<ThickOccluderSpec> for ThickOccluder {
-    type Error = CovError;
-    fn try_from(spec: ThickOccluderSpec) -> Result<ThickOccluder, CovError> {
-        ThickOccluder::new(spec.depth, spec.slices, spec.std)
+impl Build for ThickOccluderSpec {
+    type Op = ThickOccluder;
+    fn make(spec: Checked<Self>) -> Result<ThickOccluder, CovError> {
+        let w = window_var(&ThickOccluderSpec::STD, spec.std)?;
+        Ok(ThickOccluder {
+            window: Window { wx: w, wy: w },
+            step: spec.depth / f64::from(spec.slices),
+            slices: spec.slices,
+        })
     }
 }
 

@@ -56,7 +56,7 @@ fn build_defaults<S: OperatorSpec>() -> Option<Result<Arc<dyn Operator>, CovErro
 /// a third party adds its own with one call:
 ///
 /// ```
-/// use cov_core::{Axis, CovError, Operator, OperatorSpec, Spectrum};
+/// use cov_core::{Axis, Build, Checked, CovError, Operator, OperatorSpec, Registrar, Spectrum};
 /// use cov_path::{Path, Registry};
 ///
 /// #[derive(Debug)]
@@ -69,22 +69,26 @@ fn build_defaults<S: OperatorSpec>() -> Option<Result<Arc<dyn Operator>, CovErro
 /// #[derive(OperatorSpec)]
 /// #[operator(summary = "an angular blur")]
 /// struct BlurSpec {
-///     /// Lobe spectrum, ≥ 0.
-///     #[param(unit = "(cycles/tan)²")]
+///     /// Lobe spectrum.
+///     #[param(unit = "(cycles/tan)²", non_negative)]
 ///     s: f64,
 /// }
-/// impl TryFrom<BlurSpec> for Blur {
-///     type Error = CovError;
-///     fn try_from(p: BlurSpec) -> Result<Blur, CovError> {
-///         Ok(Blur(CovError::require_non_negative("Blur", "s", p.s)?))
+/// impl Build for BlurSpec {
+///     type Op = Blur;
+///     fn make(p: Checked<Self>) -> Result<Blur, CovError> {
+///         Ok(Blur(p.s))
 ///     }
 /// }
 ///
 /// let mut registry = Registry::new();
-/// registry.register::<BlurSpec>();
+/// registry.add::<BlurSpec>();
 /// let path = Path::parse("Path(source: Gaussian(x: 0.1, u: 0.2), operators: [Blur(s: 1.0)])", &registry)?;
 /// let result = path.eval()?;
 /// assert_eq!(result.layout, 2);
+/// // The declared domain, checked and positioned at the parameter as written.
+/// let text = "Path(source: Gaussian(x: 0.1, u: 0.2),\n  operators: [Blur(s: -1.0)])";
+/// let err = Path::parse(text, &registry).unwrap_err().to_string();
+/// assert!(err.contains(":2:20: Blur: parameter `s` = -1 is out of range: must be ≥ 0"), "{err}");
 /// # Ok::<(), cov_path::PathError>(())
 /// ```
 #[derive(Clone, Debug, Default)]
@@ -96,21 +100,6 @@ impl Registry {
     /// An empty registry.
     pub fn new() -> Self {
         Self::default()
-    }
-
-    /// Registers `S` under `S::NAME` (replacing an earlier entry of that name).
-    pub fn register<S: OperatorSpec>(&mut self) -> &mut Self {
-        self.entries.insert(
-            S::NAME,
-            Entry {
-                name: S::NAME,
-                summary: S::SUMMARY,
-                params: S::PARAMS,
-                build: build_erased::<S>,
-                defaults: build_defaults::<S>,
-            },
-        );
-        self
     }
 
     /// The entry named `name`.
@@ -139,8 +128,20 @@ impl Registry {
     }
 }
 
+/// The one way to register: `registry.add::<MySpec>()` (with [`Registrar`] in scope).
 impl Registrar for Registry {
+    /// Adds `S` under `S::NAME` (replacing an earlier entry of that name).
     fn add<S: OperatorSpec>(&mut self) -> &mut Self {
-        self.register::<S>()
+        self.entries.insert(
+            S::NAME,
+            Entry {
+                name: S::NAME,
+                summary: S::SUMMARY,
+                params: S::PARAMS,
+                build: build_erased::<S>,
+                defaults: build_defaults::<S>,
+            },
+        );
+        self
     }
 }

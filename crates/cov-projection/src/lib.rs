@@ -16,14 +16,14 @@
 //! Parameters, as written in a path file (`covtrace list` prints the same):
 //!
 //! <!-- parameters: generated from the specs (`COVTRACE_BLESS=1 cargo test --test param_tables`) -->
-//! | operator | parameter | unit | default | meaning |
-//! |---|---|---|---|---|
-//! | `Project` | `cos` | – | required | `\|cos θ\|`, in (0, 1]. |
-//! |  | `angle` | rad | optional | Frame rotation applied first (3D). |
-//! | `Unproject` | `cos` | – | required | `\|cos θ_out\|`, in (0, 1]. |
-//! |  | `angle` | rad | optional | Frame rotation applied last (3D). |
-//! | `Mirror` | – | | | mirror symmetry of directions, l(x, −u) (no parameters) |
-//! | `RotateFrame` | `angle` | rad | required | Angle, finite, counter-clockwise x → y. |
+//! | operator | parameter | unit | default | domain | meaning |
+//! |---|---|---|---|---|---|
+//! | `Project` | `cos` | – | required | in (0, 1] | `\|cos θ\|`. |
+//! |  | `angle` | rad | optional | finite | Frame rotation applied first (3D). |
+//! | `Unproject` | `cos` | – | required | in (0, 1] | `\|cos θ_out\|`. |
+//! |  | `angle` | rad | optional | finite | Frame rotation applied last (3D). |
+//! | `Mirror` | – | | | | mirror symmetry of directions, l(x, −u) (no parameters) |
+//! | `RotateFrame` | `angle` | rad | required | finite | Angle, counter-clockwise x → y. |
 //! <!-- end of parameters -->
 //!
 //! [`Project::from_vectors`] computes `cos` and `angle` from the ray direction, the
@@ -63,13 +63,8 @@
 
 pub mod spec;
 
-use cov_core::{Axis, AxisSet, CovError, Operator, Spectrum, Turn};
+use cov_core::{Axis, AxisSet, CovError, Operator, OperatorSpec, Spectrum, Turn};
 use glam::DVec3;
-
-#[inline]
-fn check_cos(op: &str, c: f64) -> Result<f64, CovError> {
-    CovError::require_range(op, "cos", c, |c| c > 0.0 && c <= 1.0, "must be in (0, 1]")
-}
 
 /// The frame turn of a projection: none at 0, so a flatland layout accepts it.
 #[inline(always)]
@@ -115,10 +110,11 @@ impl Project {
     /// `cos` not in (0, 1], non-finite `angle`.
     #[inline]
     pub fn with_angle(cos: f64, angle: f64) -> Result<Self, CovError> {
-        Ok(Project {
-            cos: check_cos(Self::NAME, cos)?,
-            turn: Turn::new(Self::NAME, "angle", angle)?,
-        })
+        spec::ProjectSpec {
+            cos,
+            angle: Some(angle),
+        }
+        .build()
     }
 
     /// From geometry: the ray direction `dir`, the ray frame's `x` axis `frame_x` (both
@@ -129,7 +125,12 @@ impl Project {
     /// Non-unit or non-orthogonal inputs (tolerance 1e-9), non-finite components, or a
     /// ray parallel to the surface (`cos = 0`).
     pub fn from_vectors(dir: DVec3, frame_x: DVec3, normal: DVec3) -> Result<Self, CovError> {
-        for (name, v) in [("dir", dir), ("frame_x", frame_x), ("normal", normal)] {
+        // Each vector named by its identifier.
+        for (name, v) in [
+            (stringify!(dir), dir),
+            (stringify!(frame_x), frame_x),
+            (stringify!(normal), normal),
+        ] {
             if !v.is_finite() || (v.length() - 1.0).abs() > 1e-9 {
                 return Err(CovError::OutOfRange {
                     operator: Self::NAME.into(),
@@ -142,7 +143,7 @@ impl Project {
         if dir.dot(frame_x).abs() > 1e-9 {
             return Err(CovError::OutOfRange {
                 operator: Self::NAME.into(),
-                parameter: "frame_x".into(),
+                parameter: stringify!(frame_x).into(),
                 value: dir.dot(frame_x),
                 expected: "orthogonal to dir".into(),
             });
@@ -222,10 +223,11 @@ impl Unproject {
     /// `cos` not in (0, 1], non-finite `angle`.
     #[inline]
     pub fn with_angle(cos: f64, angle: f64) -> Result<Self, CovError> {
-        Ok(Unproject {
-            cos: check_cos(Self::NAME, cos)?,
-            turn: Turn::new(Self::NAME, "angle", angle)?,
-        })
+        spec::UnprojectSpec {
+            cos,
+            angle: Some(angle),
+        }
+        .build()
     }
 }
 
@@ -299,9 +301,7 @@ impl RotateFrame {
     /// Non-finite `angle`.
     #[inline]
     pub fn new(angle: f64) -> Result<Self, CovError> {
-        Ok(RotateFrame {
-            turn: Turn::new(Self::NAME, "angle", angle)?,
-        })
+        spec::RotateFrameSpec { angle }.build()
     }
 }
 

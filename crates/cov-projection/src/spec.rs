@@ -1,7 +1,6 @@
 //! RON parameters of the projection operators.
 
-use cov_core::CovError;
-use cov_core::{OperatorSpec, Registrar};
+use cov_core::{Build, Checked, CovError, OperatorSpec, Registrar, Turn};
 
 use crate::{Mirror, Project, RotateFrame, Unproject};
 
@@ -9,17 +8,22 @@ use crate::{Mirror, Project, RotateFrame, Unproject};
 #[derive(Debug, OperatorSpec)]
 #[operator(summary = "projection from the ray onto a surface")]
 pub struct ProjectSpec {
-    /// `|cos θ|`, in (0, 1].
+    /// `|cos θ|`.
+    #[param(gt = 0, le = 1)]
     pub cos: f64,
     /// Frame rotation applied first (3D).
     #[param(unit = "rad", default)]
     pub angle: Option<f64>,
 }
 
-impl TryFrom<ProjectSpec> for Project {
-    type Error = CovError;
-    fn try_from(spec: ProjectSpec) -> Result<Project, CovError> {
-        Project::with_angle(spec.cos, spec.angle.unwrap_or(0.0))
+impl Build for ProjectSpec {
+    type Op = Project;
+    #[inline]
+    fn make(spec: Checked<Self>) -> Result<Project, CovError> {
+        Ok(Project {
+            cos: spec.cos,
+            turn: Turn::new(ProjectSpec::ANGLE.of(spec.angle.unwrap_or(0.0)))?,
+        })
     }
 }
 
@@ -27,17 +31,22 @@ impl TryFrom<ProjectSpec> for Project {
 #[derive(Debug, OperatorSpec)]
 #[operator(summary = "inverse projection from a surface to the outgoing ray")]
 pub struct UnprojectSpec {
-    /// `|cos θ_out|`, in (0, 1].
+    /// `|cos θ_out|`.
+    #[param(gt = 0, le = 1)]
     pub cos: f64,
     /// Frame rotation applied last (3D).
     #[param(unit = "rad", default)]
     pub angle: Option<f64>,
 }
 
-impl TryFrom<UnprojectSpec> for Unproject {
-    type Error = CovError;
-    fn try_from(spec: UnprojectSpec) -> Result<Unproject, CovError> {
-        Unproject::with_angle(spec.cos, spec.angle.unwrap_or(0.0))
+impl Build for UnprojectSpec {
+    type Op = Unproject;
+    #[inline]
+    fn make(spec: Checked<Self>) -> Result<Unproject, CovError> {
+        Ok(Unproject {
+            cos: spec.cos,
+            turn: Turn::new(UnprojectSpec::ANGLE.of(spec.angle.unwrap_or(0.0)))?,
+        })
     }
 }
 
@@ -46,9 +55,9 @@ impl TryFrom<UnprojectSpec> for Unproject {
 #[operator(summary = "mirror symmetry of directions, l(x, −u)")]
 pub struct MirrorSpec {}
 
-impl TryFrom<MirrorSpec> for Mirror {
-    type Error = CovError;
-    fn try_from(_: MirrorSpec) -> Result<Mirror, CovError> {
+impl Build for MirrorSpec {
+    type Op = Mirror;
+    fn make(_: Checked<Self>) -> Result<Mirror, CovError> {
         Ok(Mirror)
     }
 }
@@ -57,15 +66,18 @@ impl TryFrom<MirrorSpec> for Mirror {
 #[derive(Debug, OperatorSpec)]
 #[operator(summary = "rotation of the tangent frame (3D)")]
 pub struct RotateFrameSpec {
-    /// Angle, finite, counter-clockwise x → y.
+    /// Angle, counter-clockwise x → y.
     #[param(unit = "rad")]
     pub angle: f64,
 }
 
-impl TryFrom<RotateFrameSpec> for RotateFrame {
-    type Error = CovError;
-    fn try_from(spec: RotateFrameSpec) -> Result<RotateFrame, CovError> {
-        RotateFrame::new(spec.angle)
+impl Build for RotateFrameSpec {
+    type Op = RotateFrame;
+    #[inline]
+    fn make(spec: Checked<Self>) -> Result<RotateFrame, CovError> {
+        Ok(RotateFrame {
+            turn: Turn::new(RotateFrameSpec::ANGLE.of(spec.angle))?,
+        })
     }
 }
 

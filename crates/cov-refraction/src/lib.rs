@@ -16,15 +16,15 @@
 //! Parameters, as written in a path file (`covtrace list` prints the same):
 //!
 //! <!-- parameters: generated from the specs (`COVTRACE_BLESS=1 cargo test --test param_tables`) -->
-//! | operator | parameter | unit | default | meaning |
-//! |---|---|---|---|---|
-//! | `Refract` | `n1` | – | required | Refractive index on the incident side, > 0. |
-//! |  | `n2` | – | required | Refractive index on the transmitted side, > 0. |
-//! |  | `cos_i` | – | required | `\|cos θ_i\|`, in (0, 1]; total internal reflection is an error. |
-//! | `RoughRefract` | `n1` | – | required | Refractive index on the incident side, > 0. |
-//! |  | `n2` | – | required | Refractive index on the transmitted side, > 0. |
-//! |  | `cos_i` | – | required | `\|cos θ_i\|`, in (0, 1]. |
-//! |  | `lobe` | – | required | Transmission lobe, as in `Brdf`. |
+//! | operator | parameter | unit | default | domain | meaning |
+//! |---|---|---|---|---|---|
+//! | `Refract` | `n1` | – | required | > 0 | Refractive index on the incident side. |
+//! |  | `n2` | – | required | > 0 | Refractive index on the transmitted side. |
+//! |  | `cos_i` | – | required | in (0, 1] | `\|cos θ_i\|`; total internal reflection is an error. |
+//! | `RoughRefract` | `n1` | – | required | > 0 | Refractive index on the incident side. |
+//! |  | `n2` | – | required | > 0 | Refractive index on the transmitted side. |
+//! |  | `cos_i` | – | required | in (0, 1] | `\|cos θ_i\|`. |
+//! |  | `lobe` | – | required | – | Transmission lobe, as in `Brdf`. |
 //! <!-- end of parameters -->
 //!
 //! ```
@@ -66,7 +66,7 @@
 pub mod spec;
 
 use cov_brdf::Lobe;
-use cov_core::{Axis, CovError, Operator, Spectrum};
+use cov_core::{Axis, CovError, Operator, OperatorSpec, Spectrum};
 
 /// A smooth interface between media of indices `n1` (incident side) and `n2`.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -85,15 +85,12 @@ impl Refract {
     /// Non-positive or non-finite indices, `cos_i` not in (0, 1], or total internal
     /// reflection ([`CovError::NoTransport`]).
     pub fn new(n1: f64, n2: f64, cos_i: f64) -> Result<Self, CovError> {
-        CovError::require_positive(Self::NAME, "n1", n1)?;
-        CovError::require_positive(Self::NAME, "n2", n2)?;
-        CovError::require_range(
-            Self::NAME,
-            "cos_i",
-            cos_i,
-            |c| c > 0.0 && c <= 1.0,
-            "must be in (0, 1]",
-        )?;
+        spec::RefractSpec { n1, n2, cos_i }.build()
+    }
+
+    /// Snell's law on parameters checked by the spec: only total internal reflection
+    /// is left to report.
+    fn snell(n1: f64, n2: f64, cos_i: f64) -> Result<Self, CovError> {
         let eta = n1 / n2;
         // sin²θ_i = (1 − cos)(1 + cos): no cancellation near normal incidence.
         let sin2_i = (1.0 - cos_i) * (1.0 + cos_i);
@@ -151,10 +148,7 @@ impl RoughRefract {
     /// # Errors
     /// As [`Refract::new`], or invalid lobe parameters.
     pub fn new(n1: f64, n2: f64, cos_i: f64, lobe: Lobe) -> Result<Self, CovError> {
-        Ok(RoughRefract {
-            refract: Refract::new(n1, n2, cos_i)?,
-            lobe: lobe.validated()?,
-        })
+        spec::RoughRefractSpec { n1, n2, cos_i, lobe }.build()
     }
 }
 

@@ -1,8 +1,7 @@
 //! RON parameters of the refraction operators.
 
 use cov_brdf::Lobe;
-use cov_core::CovError;
-use cov_core::{OperatorSpec, Registrar};
+use cov_core::{Build, Checked, CovError, OperatorSpec, Registrar};
 
 use crate::{Refract, RoughRefract};
 
@@ -10,18 +9,21 @@ use crate::{Refract, RoughRefract};
 #[derive(Debug, OperatorSpec)]
 #[operator(summary = "smooth refraction (Snell) at an interface")]
 pub struct RefractSpec {
-    /// Refractive index on the incident side, > 0.
+    /// Refractive index on the incident side.
+    #[param(positive)]
     pub n1: f64,
-    /// Refractive index on the transmitted side, > 0.
+    /// Refractive index on the transmitted side.
+    #[param(positive)]
     pub n2: f64,
-    /// `|cos θ_i|`, in (0, 1]; total internal reflection is an error.
+    /// `|cos θ_i|`; total internal reflection is an error.
+    #[param(gt = 0, le = 1)]
     pub cos_i: f64,
 }
 
-impl TryFrom<RefractSpec> for Refract {
-    type Error = CovError;
-    fn try_from(spec: RefractSpec) -> Result<Refract, CovError> {
-        Refract::new(spec.n1, spec.n2, spec.cos_i)
+impl Build for RefractSpec {
+    type Op = Refract;
+    fn make(spec: Checked<Self>) -> Result<Refract, CovError> {
+        Refract::snell(spec.n1, spec.n2, spec.cos_i)
     }
 }
 
@@ -29,20 +31,26 @@ impl TryFrom<RefractSpec> for Refract {
 #[derive(Debug, OperatorSpec)]
 #[operator(summary = "rough refraction: Snell then a transmission lobe")]
 pub struct RoughRefractSpec {
-    /// Refractive index on the incident side, > 0.
+    /// Refractive index on the incident side.
+    #[param(positive)]
     pub n1: f64,
-    /// Refractive index on the transmitted side, > 0.
+    /// Refractive index on the transmitted side.
+    #[param(positive)]
     pub n2: f64,
-    /// `|cos θ_i|`, in (0, 1].
+    /// `|cos θ_i|`.
+    #[param(gt = 0, le = 1)]
     pub cos_i: f64,
     /// Transmission lobe, as in `Brdf`.
     pub lobe: Lobe,
 }
 
-impl TryFrom<RoughRefractSpec> for RoughRefract {
-    type Error = CovError;
-    fn try_from(spec: RoughRefractSpec) -> Result<RoughRefract, CovError> {
-        RoughRefract::new(spec.n1, spec.n2, spec.cos_i, spec.lobe)
+impl Build for RoughRefractSpec {
+    type Op = RoughRefract;
+    fn make(spec: Checked<Self>) -> Result<RoughRefract, CovError> {
+        Ok(RoughRefract {
+            refract: Refract::snell(spec.n1, spec.n2, spec.cos_i)?,
+            lobe: spec.lobe.validated()?,
+        })
     }
 }
 

@@ -24,17 +24,17 @@
 //! Parameters, as written in a path file (`covtrace list` prints the same):
 //!
 //! <!-- parameters: generated from the specs (`COVTRACE_BLESS=1 cargo test --test param_tables`) -->
-//! | operator | parameter | unit | default | meaning |
-//! |---|---|---|---|---|
-//! | `Sensor` | `width` | px | required | Image width, ≥ 1. |
-//! |  | `fov_x` | rad | required | Horizontal field of view, in (0, π). |
-//! |  | `distance` | m | `1.0` | Lens (or pinhole) to sensor. |
-//! |  | `filter` | px | `0.5` | Pixel filter std. |
-//! |  | `aperture` | m | optional | Aperture std, when the lens is sampled. |
-//! |  | `shutter` | s | optional | Shutter std, when time is sampled (needs axis `t`). |
-//! |  | `nyquist` | – | `NYQUIST_K` | Nyquist factor k. |
-//! |  | `max_filter` | px | `8.0` | Largest filter std. |
-//! | `Integrate` | `axes` | – | required | Axes to integrate over: a list of `x`, `y`, `u`, `v`, `t`. |
+//! | operator | parameter | unit | default | domain | meaning |
+//! |---|---|---|---|---|---|
+//! | `Sensor` | `width` | px | required | ≥ 1 | Image width. |
+//! |  | `fov_x` | rad | required | in (0, π) | Horizontal field of view. |
+//! |  | `distance` | m | `1.0` | > 0 | Lens (or pinhole) to sensor. |
+//! |  | `filter` | px | `0.5` | > 0 | Pixel filter std. |
+//! |  | `aperture` | m | optional | in (0, 1e6] | Aperture std, when the lens is sampled. |
+//! |  | `shutter` | s | optional | in (0, 1e6] | Shutter std, when time is sampled (needs axis `t`). |
+//! |  | `nyquist` | – | `NYQUIST_K` | in (0, 1e3] | Nyquist factor k. |
+//! |  | `max_filter` | px | `8.0` | in (0, 1e6] | Largest filter std. (The upper bounds here are far beyond any use, so that no decision overflows f64: a squared `max_filter` of 1e155 px would.) |
+//! | `Integrate` | `axes` | – | required | – | Axes to integrate over: a list of `x`, `y`, `u`, `v`, `t`. |
 //! <!-- end of parameters -->
 //!
 //! As an operator, `Sensor` applies the pixel filter and integrates over `u`, `v`, `t`:
@@ -80,8 +80,8 @@ pub mod spec;
 use std::f64::consts::PI;
 
 use cov_core::{
-    AnyCov, Axis, AxisSet, CovError, FOUR_PI_SQ, Field, NYQUIST_K, Operator, Report, ReportField, Spectrum,
-    axis_index,
+    AnyCov, Axis, AxisSet, CovError, FOUR_PI_SQ, Field, NYQUIST_K, Operator, OperatorSpec, Report,
+    ReportField, Spectrum, axis_index,
 };
 use serde::{Deserialize, Serialize};
 
@@ -90,33 +90,33 @@ use serde::{Deserialize, Serialize};
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, cov_core::OperatorSpec)]
 #[operator(
     name = "Sensor",
-    op = Sensor,
     summary = "the sensor: pixel filter, integration over lens and shutter, per-pixel decisions"
 )]
 pub struct SensorParams {
-    /// Image width, ≥ 1.
-    #[param(unit = "px")]
+    /// Image width.
+    #[param(unit = "px", ge = 1)]
     pub width: u32,
-    /// Horizontal field of view, in (0, π).
-    #[param(unit = "rad")]
+    /// Horizontal field of view.
+    #[param(unit = "rad", gt = 0, lt = PI)]
     pub fov_x: f64,
     /// Lens (or pinhole) to sensor.
-    #[param(unit = "m", default = 1.0)]
+    #[param(unit = "m", default = 1.0, positive)]
     pub distance: f64,
     /// Pixel filter std.
-    #[param(unit = "px", default = 0.5)]
+    #[param(unit = "px", default = 0.5, positive)]
     pub filter: f64,
     /// Aperture std, when the lens is sampled.
-    #[param(unit = "m", default)]
+    #[param(unit = "m", default, gt = 0, le = 1e6)]
     pub aperture: Option<f64>,
     /// Shutter std, when time is sampled (needs axis `t`).
-    #[param(unit = "s", default)]
+    #[param(unit = "s", default, gt = 0, le = 1e6)]
     pub shutter: Option<f64>,
     /// Nyquist factor k.
-    #[param(default = NYQUIST_K)]
+    #[param(default = NYQUIST_K, gt = 0, le = 1e3)]
     pub nyquist: f64,
-    /// Largest filter std.
-    #[param(unit = "px", default = 8.0)]
+    /// Largest filter std. (The upper bounds here are far beyond any use, so that no
+    /// decision overflows f64: a squared `max_filter` of 1e155 px would.)
+    #[param(unit = "px", default = 8.0, gt = 0, le = 1e6)]
     pub max_filter: f64,
 }
 
@@ -141,13 +141,6 @@ pub struct Sensor {
     p: SensorParams,
     pitch: f64,
 }
-
-/// Largest Nyquist factor a sensor accepts.
-pub const MAX_NYQUIST: f64 = 1e3;
-/// Largest reconstruction filter std a sensor accepts (px).
-pub const MAX_FILTER_PX: f64 = 1e6;
-/// Largest aperture (m) or shutter (s) std a sensor accepts.
-pub const MAX_EXTENT: f64 = 1e6;
 
 /// Largest layout (`cov_core::linalg`'s matrix side).
 const MAX: usize = cov_core::linalg::MAX;
@@ -197,70 +190,7 @@ impl Sensor {
     /// # Errors
     /// Any parameter outside its domain (named).
     pub fn new(p: SensorParams) -> Result<Self, CovError> {
-        if p.width == 0 {
-            return Err(CovError::OutOfRange {
-                operator: Self::NAME.into(),
-                parameter: "width".into(),
-                value: 0.0,
-                expected: "must be ≥ 1".into(),
-            });
-        }
-        CovError::require_range(
-            Self::NAME,
-            "fov_x",
-            p.fov_x,
-            |f| f > 0.0 && f < PI,
-            "must be in (0, π)",
-        )?;
-        CovError::require_positive(Self::NAME, "distance", p.distance)?;
-        CovError::require_positive(Self::NAME, "filter", p.filter)?;
-        // Bounds far beyond any use, so that no decision overflows f64 (a squared
-        // `max_filter` of 1e155 px would, and silently gave a filter of 0 px).
-        let within = |v: f64, hi: f64| v > 0.0 && v <= hi;
-        CovError::require_range(
-            Self::NAME,
-            "nyquist",
-            p.nyquist,
-            |v| within(v, MAX_NYQUIST),
-            "must be in (0, 1e3]",
-        )?;
-        CovError::require_range(
-            Self::NAME,
-            "max_filter",
-            p.max_filter,
-            |v| within(v, MAX_FILTER_PX),
-            "must be in (0, 1e6] px",
-        )?;
-        if let Some(a) = p.aperture {
-            CovError::require_range(
-                Self::NAME,
-                "aperture",
-                a,
-                |v| within(v, MAX_EXTENT),
-                "must be in (0, 1e6] m",
-            )?;
-        }
-        if let Some(s) = p.shutter {
-            CovError::require_range(
-                Self::NAME,
-                "shutter",
-                s,
-                |v| within(v, MAX_EXTENT),
-                "must be in (0, 1e6] s",
-            )?;
-        }
-        let pitch = 2.0 * p.distance * (0.5 * p.fov_x).tan() / f64::from(p.width);
-        CovError::require_positive(Self::NAME, "pitch", pitch)?;
-        // The pixel filter's window, reported on the user's `filter` when it overflows.
-        let s = p.filter * pitch;
-        CovError::require_range(
-            Self::NAME,
-            "filter",
-            p.filter,
-            |_| (1.0 / (FOUR_PI_SQ * s * s)).is_finite(),
-            "too small: the pixel filter's spectrum variance overflows f64",
-        )?;
-        Ok(Sensor { p, pitch })
+        p.build()
     }
 
     /// Metres per pixel on the sensor plane.
@@ -549,12 +479,10 @@ impl Operator for Integrate {
     /// nothing (a renderer integrates over what it samples and keeps the image axes).
     fn apply(&self, cov: &mut dyn Spectrum) -> Result<(), CovError> {
         if cov.axes().iter().all(|a| self.axes.contains(a)) {
-            return Err(CovError::OutOfRange {
-                operator: Self::NAME.into(),
-                parameter: "axes".into(),
-                value: self.axes.len() as f64,
-                expected: "must leave at least one axis of the layout: integrating every axis leaves nothing to describe".into(),
-            });
+            return Err(spec::IntegrateSpec::AXES.error(
+                self.axes.len() as f64,
+                "must leave at least one axis of the layout: integrating every axis leaves nothing to describe",
+            ));
         }
         cov.integrate(&self.axes)
     }

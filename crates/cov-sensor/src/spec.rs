@@ -1,14 +1,31 @@
 //! RON parameters of the sensor operators.
 
-use cov_core::{Axis, CovError};
-use cov_core::{OperatorSpec, Registrar};
+use cov_core::{Axis, Build, Checked, CovError, FOUR_PI_SQ, OperatorSpec, Registrar};
 
 use crate::{Integrate, Sensor, SensorParams};
 
-impl TryFrom<SensorParams> for Sensor {
-    type Error = CovError;
-    fn try_from(p: SensorParams) -> Result<Sensor, CovError> {
-        Sensor::new(p)
+impl Build for SensorParams {
+    type Op = Sensor;
+    fn make(p: Checked<Self>) -> Result<Sensor, CovError> {
+        let p = p.into_inner();
+        let pitch = 2.0 * p.distance * (0.5 * p.fov_x).tan() / f64::from(p.width);
+        if !(pitch > 0.0 && pitch.is_finite()) {
+            return Err(SensorParams::DISTANCE.error(
+                p.distance,
+                format!(
+                    "gives a pixel pitch of {pitch} m (with this fov_x and width): it must be finite and > 0"
+                ),
+            ));
+        }
+        // The pixel filter's window, reported on the user's `filter` when it overflows.
+        let s = p.filter * pitch;
+        if !(1.0 / (FOUR_PI_SQ * s * s)).is_finite() {
+            return Err(SensorParams::FILTER.error(
+                p.filter,
+                "too small: the pixel filter's spectrum variance overflows f64",
+            ));
+        }
+        Ok(Sensor { p, pitch })
     }
 }
 
@@ -20,10 +37,10 @@ pub struct IntegrateSpec {
     pub axes: Vec<Axis>,
 }
 
-impl TryFrom<IntegrateSpec> for Integrate {
-    type Error = CovError;
-    fn try_from(spec: IntegrateSpec) -> Result<Integrate, CovError> {
-        Integrate::new(spec.axes)
+impl Build for IntegrateSpec {
+    type Op = Integrate;
+    fn make(spec: Checked<Self>) -> Result<Integrate, CovError> {
+        Integrate::new(spec.into_inner().axes)
     }
 }
 

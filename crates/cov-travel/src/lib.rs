@@ -10,9 +10,9 @@
 //! Parameters, as written in a path file (`covtrace list` prints the same):
 //!
 //! <!-- parameters: generated from the specs (`COVTRACE_BLESS=1 cargo test --test param_tables`) -->
-//! | operator | parameter | unit | default | meaning |
-//! |---|---|---|---|---|
-//! | `Travel` | `distance` | m | required | Distance (m); finite; negative travels back |
+//! | operator | parameter | unit | default | domain | meaning |
+//! |---|---|---|---|---|---|
+//! | `Travel` | `distance` | m | required | finite | Distance; negative travels back. |
 //! <!-- end of parameters -->
 //!
 //! Layouts: all (N = 2, 3, 4, 5); needs `x, u`.
@@ -46,7 +46,7 @@
 
 pub mod spec;
 
-use cov_core::{CovError, Operator, Spectrum};
+use cov_core::{CovError, Operator, OperatorSpec, Spectrum};
 
 /// Travel by `distance` metres along the ray.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -62,8 +62,7 @@ impl Travel {
     /// [`CovError::NonFinite`] if `distance` is NaN or infinite.
     #[inline]
     pub fn new(distance: f64) -> Result<Self, CovError> {
-        CovError::require_finite(Self::NAME, "distance", distance)?;
-        Ok(Travel { distance })
+        spec::TravelSpec { distance }.build()
     }
 
     /// The distance (m).

@@ -1,7 +1,6 @@
 //! RON parameters of the travel operator.
 
-use cov_core::CovError;
-use cov_core::{OperatorSpec, Registrar};
+use cov_core::{Build, Checked, CovError, OperatorSpec, Registrar};
 
 use crate::Travel;
 
@@ -9,15 +8,18 @@ use crate::Travel;
 #[derive(Debug, OperatorSpec)]
 #[operator(summary = "free-space travel along the ray")]
 pub struct TravelSpec {
-    /// Distance (m); finite; negative travels back
+    /// Distance; negative travels back.
     #[param(unit = "m")]
     pub distance: f64,
 }
 
-impl TryFrom<TravelSpec> for Travel {
-    type Error = CovError;
-    fn try_from(spec: TravelSpec) -> Result<Travel, CovError> {
-        Travel::new(spec.distance)
+impl Build for TravelSpec {
+    type Op = Travel;
+    #[inline]
+    fn make(spec: Checked<Self>) -> Result<Travel, CovError> {
+        Ok(Travel {
+            distance: spec.distance,
+        })
     }
 }
 

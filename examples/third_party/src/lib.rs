@@ -3,7 +3,7 @@
 //! (rule 2) and whose facets spread the reflection in angle (rule 3, variance `spread`).
 //! Nothing in the covtrace crates knows about it: [`register`] adds it to a registry.
 
-use covtrace::{CovError, FOUR_PI_SQ, Operator, OperatorSpec, Registrar, Spectrum};
+use covtrace::{Build, Checked, CovError, FOUR_PI_SQ, Operator, OperatorSpec, Registrar, Spectrum};
 
 /// The operator.
 #[derive(Clone, Copy, Debug)]
@@ -28,23 +28,36 @@ impl Operator for Sparkle {
 #[derive(Debug, OperatorSpec)]
 #[operator(summary = "glitter: flake texture and facet spread (third-party example)")]
 pub struct SparkleSpec {
-    /// Flake size, > 0.
-    #[param(unit = "m")]
+    /// Flake size.
+    #[param(unit = "m", positive)]
     pub flake: f64,
-    /// Angular variance of the facets, > 0.
-    #[param(unit = "tan²")]
+    /// Angular variance of the facets.
+    #[param(unit = "tan²", positive)]
     pub spread: f64,
 }
 
-impl TryFrom<SparkleSpec> for Sparkle {
-    type Error = CovError;
-    fn try_from(p: SparkleSpec) -> Result<Sparkle, CovError> {
-        let flake = CovError::require_positive("Sparkle", "flake", p.flake)?;
-        let spread = CovError::require_positive("Sparkle", "spread", p.spread)?;
+/// The operator this spec builds, from parameters already checked against their domains.
+impl Build for SparkleSpec {
+    type Op = Sparkle;
+    fn make(p: Checked<Self>) -> Result<Sparkle, CovError> {
+        let window = 1.0 / (FOUR_PI_SQ * p.flake * p.flake);
+        if !window.is_finite() {
+            return Err(SparkleSpec::FLAKE.error(p.flake, "too small: 1/(4π² flake²) overflows"));
+        }
         Ok(Sparkle {
-            window: 1.0 / (FOUR_PI_SQ * flake * flake),
-            lobe: 1.0 / (FOUR_PI_SQ * spread),
+            window,
+            lobe: 1.0 / (FOUR_PI_SQ * p.spread),
         })
+    }
+}
+
+impl Sparkle {
+    /// For Rust callers: the same checks as a file's.
+    ///
+    /// # Errors
+    /// A parameter out of its domain, named.
+    pub fn new(flake: f64, spread: f64) -> Result<Sparkle, CovError> {
+        SparkleSpec { flake, spread }.build()
     }
 }
 

@@ -34,8 +34,15 @@ fn bad_sparkle_parameter_is_positioned() {
         &registry,
     )
     .expect_err("flake must be > 0");
-    assert!(err.to_string().starts_with("<string>:1:"), "{err}");
-    assert!(err.to_string().contains("flake"), "{err}");
+    // At the parameter as written, with the domain declared on the field.
+    assert_eq!(
+        err.to_string(),
+        "<string>:1:52: Sparkle: parameter `flake` = 0 is out of range: must be > 0"
+    );
+    // Rust callers get the same check.
+    let err = covtrace_sparkle::Sparkle::new(0.0, 1.0).expect_err("flake must be > 0");
+    assert_eq!(err.to_string(), "Sparkle: parameter `flake` = 0 is out of range: must be > 0");
+    assert!(covtrace_sparkle::Sparkle::new(1e-3, f64::NAN).is_err());
 }
 
 /// The operator in every layout (2 to 5) and both forms of Σ, against its closed form:
