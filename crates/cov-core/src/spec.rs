@@ -142,7 +142,7 @@ impl Param {
     ///
     /// # Errors
     /// [`CovError::NonFinite`] or [`CovError::OutOfRange`].
-    #[inline]
+    #[inline(always)]
     pub fn require(
         &self,
         value: f64,
@@ -167,7 +167,7 @@ impl Param {
         self.require_named(Some(k), value, ok, expected)
     }
 
-    #[inline]
+    #[inline(always)]
     fn require_named(
         &self,
         k: Option<usize>,
@@ -270,7 +270,7 @@ impl Arg {
     ///
     /// # Errors
     /// [`CovError::NonFinite`].
-    #[inline]
+    #[inline(always)]
     pub fn finite(self) -> Result<f64, CovError> {
         self.require(|_| true, String::new)
     }
@@ -321,7 +321,7 @@ pub trait ParamValue {
 }
 
 impl ParamValue for f64 {
-    #[inline]
+    #[inline(always)]
     fn check_param(
         &self,
         p: &Param,
@@ -353,7 +353,7 @@ macro_rules! integer_param {
 integer_param!(u32, u64, usize, i32, i64);
 
 impl<T: ParamValue> ParamValue for Option<T> {
-    #[inline]
+    #[inline(always)]
     fn check_param(
         &self,
         p: &Param,
@@ -468,7 +468,7 @@ pub trait OperatorSpec: Build + 'static {
     ///
     /// # Errors
     /// Invalid parameters (NaN, out of range): the message names the parameter.
-    #[inline]
+    #[inline(always)]
     fn build(self) -> Result<Self::Op, CovError> {
         self.check()?;
         <Self as Build>::make(Checked(self))

@@ -89,13 +89,15 @@ impl Curvature {
     /// Non-finite parameters.
     #[inline]
     pub fn anisotropic(kx: f64, ky: f64, angle: f64) -> Result<Self, CovError> {
+        // The spec's checks; the principal form needs none of `make`'s choice of form.
         spec::CurvatureSpec {
             k: None,
             kx: Some(kx),
             ky: Some(ky),
             angle: Some(angle),
         }
-        .build()
+        .check()?;
+        Self::checked(kx, ky, angle)
     }
 
     /// From curvatures checked by the spec.

@@ -387,7 +387,7 @@ fn expand(input: &DeriveInput) -> syn::Result<Tokens> {
             const SUMMARY: &'static str = #summary;
             const PARAMS: &'static [#core::Param] = &[#(#ty::#consts),*];
 
-            #[inline]
+            #[inline(always)]
             // `lo < v && v <= hi` is written as declared; the message says the same.
             #[allow(clippy::manual_range_contains)]
             fn check(&self) -> ::core::result::Result<(), #core::CovError> {
