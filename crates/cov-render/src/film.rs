@@ -164,70 +164,50 @@ impl Gaussian {
         [r / det, -q / det, p / det]
     }
 
-    /// Calls `add(cell, weight)` for the cells `x − r ..= x + r` of `row` (clipped to it)
-    /// whose index is a multiple of `step` (every cell for 1) at vertical offset `dy`, with
-    /// the weight at offset `(cell − x, dy)` where it is inside the [`CUTOFF`] ellipse.
-    /// Walks outward from the row's peak with the Gaussian's ratio recurrence (two
-    /// products a cell, two `exp` a row), so the weights only decrease along a walk and
-    /// underflow stops it, never skips a cell.
-    pub fn splat_row<T>(
-        &self,
-        row: &mut [T],
-        x: usize,
-        dy: f64,
-        r: usize,
-        step: usize,
-        mut add: impl FnMut(&mut T, f64),
-    ) {
+    /// Calls `add(cell, weight)` for the cells `x − r ..= x + r` of `row` (clipped to it) at
+    /// vertical offset `dy`, with the weight at offset `(cell − x, dy)` where it is inside
+    /// the [`CUTOFF`] ellipse. Walks outward from the row's peak with the Gaussian's
+    /// ratio recurrence (two products a cell, two `exp` a row), so the
+    /// weights only decrease along a walk and underflow stops it, never skips a cell.
+    pub fn splat_row<T>(&self, row: &mut [T], x: usize, dy: f64, r: usize, mut add: impl FnMut(&mut T, f64)) {
         let [p, q, rr] = self.precision;
-        let st = step.max(1) as i64;
-        let xi = x as i64;
-        // The first and last cells of the grid within reach, as offsets from x.
-        let lo = (x.saturating_sub(r) as i64 + st - 1) / st * st - xi;
-        let hi = ((x + r).min(row.len().saturating_sub(1)) as i64) / st * st - xi;
+        let lo = x.saturating_sub(r) as i64 - x as i64;
+        let hi = ((x + r).min(row.len().saturating_sub(1)) as i64) - x as i64;
         if lo > hi {
             return;
         }
         let e_at = |dx: f64| p * dx * dx + 2.0 * q * dx * dy + rr * dy * dy;
-        // The grid cell nearest the row's peak.
-        let peak = xi + (-q * dy / p).round() as i64;
-        let c = ((peak as f64 / st as f64).round() as i64 * st - xi).clamp(lo, hi);
+        let c = ((-q * dy / p).round() as i64).clamp(lo, hi);
         let cut = CUTOFF * CUTOFF;
-        let s = st as f64;
-        // exp(−p s²): the recurrence factor of a step of s cells.
-        let decay = if st == 1 {
-            self.decay
-        } else {
-            self.decay.powi((st * st) as i32)
-        };
-        // w(c ± s) / w(c) = exp(∓(½p(2c ± s)s + q dy s)): with a = exp(½p(2c − s)s + q dy s),
-        // the step right from c is decay / a and the step left from c is a (then each step
+        let decay = self.decay;
+        // w(c ± 1) / w(c) = exp(∓(½p(2c ± 1) + q dy)): with a = exp(½p(2c − 1) + q dy), the
+        // step right from c is decay / a and the step left from c is a (then each step
         // multiplies by decay): two `exp` a row.
-        let a = (0.5 * p * ((2 * c - st) * st) as f64 + q * dy * s).exp();
+        let a = (0.5 * p * (2 * c - 1) as f64 + q * dy).exp();
         let w_c = self.norm * (-0.5 * e_at(c as f64)).exp();
         // Rightwards from the peak c.
         let (mut e, mut wgt) = (e_at(c as f64), w_c);
         let mut ratio = decay / a;
-        for dx in (c..=hi).step_by(st as usize) {
+        for dx in c..=hi {
             if e > cut || wgt == 0.0 {
                 break;
             }
-            add(&mut row[(xi + dx) as usize], wgt);
-            e += p * ((2 * dx + st) * st) as f64 + 2.0 * q * dy * s;
+            add(&mut row[(x as i64 + dx) as usize], wgt);
+            e += p * (2 * dx + 1) as f64 + 2.0 * q * dy;
             wgt *= ratio;
             ratio *= decay;
         }
-        // Leftwards from c − s.
+        // Leftwards from c − 1.
         if c > lo {
-            let d = c - st;
+            let d = c - 1;
             let (mut e, mut wgt) = (e_at(d as f64), w_c * a);
             let mut ratio = a * decay;
-            for dx in (lo..=d).rev().step_by(st as usize) {
+            for dx in (lo..=d).rev() {
                 if e > cut || wgt == 0.0 {
                     break;
                 }
-                add(&mut row[(xi + dx) as usize], wgt);
-                e -= p * ((2 * dx - st) * st) as f64 + 2.0 * q * dy * s;
+                add(&mut row[(x as i64 + dx) as usize], wgt);
+                e -= p * (2 * dx - 1) as f64 + 2.0 * q * dy;
                 wgt *= ratio;
                 ratio *= decay;
             }
@@ -389,14 +369,6 @@ impl Film {
     /// sample count (the two sums whose ratio [`Film::image`] takes); zero for
     /// [`Filter::Box`] pixels, which splat nothing.
     pub fn splat(&self, filter: &Filter) -> Vec<(DVec3, f64)> {
-        self.splat_on(filter, 1)
-    }
-
-    /// [`Film::splat`] into the pixels whose column and row are multiples of `step` only
-    /// (every sample still splats): the sums on a grid `step` times coarser, for about
-    /// `1/step²` of the work; the other pixels stay zero.
-    pub fn splat_on(&self, filter: &Filter, step: usize) -> Vec<(DVec3, f64)> {
-        let step = step.max(1);
         let (w, h) = (self.width as usize, self.height as usize);
         // Each band of rows splats into a buffer with a margin as deep as its filters reach.
         let bands: Vec<(usize, Vec<(DVec3, f64)>)> = (0..h.div_ceil(BAND))
@@ -420,10 +392,9 @@ impl Film {
                             continue;
                         }
                         let r = (CUTOFF * g.std_max).ceil() as usize;
-                        let first = y.saturating_sub(r).div_ceil(step) * step;
-                        for py in (first..(y + r + 1).min(h)).step_by(step) {
+                        for py in y.saturating_sub(r)..(y + r + 1).min(h) {
                             let row = &mut buf[(py - top) * w..(py - top + 1) * w];
-                            g.splat_row(row, x, py as f64 - y as f64, r, step, |e, wgt| {
+                            g.splat_row(row, x, py as f64 - y as f64, r, |e, wgt| {
                                 e.0 += s * wgt;
                                 e.1 += n * wgt;
                             });
@@ -602,21 +573,19 @@ mod tests {
             let r = (CUTOFF * g.std_max()).ceil() as usize;
             for x in [0usize, 3, r, 40] {
                 for dy in -(r as i64)..=(r as i64) {
-                    for step in [1usize, 2, 3] {
-                        let mut row = vec![0.0; 50];
-                        g.splat_row(&mut row, x, dy as f64, r, step, |e, w| *e += w);
-                        for (k, v) in row.iter().enumerate() {
-                            let dx = k as f64 - x as f64;
-                            let want = if dx.abs() <= r as f64 && k % step == 0 {
-                                g.weight(dx, dy as f64)
-                            } else {
-                                0.0
-                            };
-                            assert!(
-                                (v - want).abs() <= 1e-12 * g.norm,
-                                "{c:?} x {x} dy {dy} step {step} cell {k}: {v} vs {want}"
-                            );
-                        }
+                    let mut row = vec![0.0; 50];
+                    g.splat_row(&mut row, x, dy as f64, r, |e, w| *e += w);
+                    for (k, v) in row.iter().enumerate() {
+                        let dx = k as f64 - x as f64;
+                        let want = if dx.abs() <= r as f64 {
+                            g.weight(dx, dy as f64)
+                        } else {
+                            0.0
+                        };
+                        assert!(
+                            (v - want).abs() <= 1e-12 * g.norm,
+                            "{c:?} x {x} dy {dy} cell {k}: {v} vs {want}"
+                        );
                     }
                 }
             }

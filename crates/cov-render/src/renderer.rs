@@ -43,7 +43,7 @@ use crate::adaptive::{Guide, MAX_RATIO, allocate, allocate_floors, filter_area, 
 use crate::covpass::{CovMaps, MAX_COV_PATHS, STRIDES, covariance_maps};
 use crate::denoise::Denoise;
 use crate::film::{Film, Filter, Gaussian, Image, MAX_SPP, Progress};
-use crate::guard::{candidate, candidates, guard_filters, guarded};
+use crate::guard::{candidate, candidates, guarded};
 use crate::world::World;
 
 /// Std of the fixed Gaussian filter of the `gauss` baseline (px).
@@ -410,9 +410,9 @@ impl<'w> Renderer<'w> {
                     vec![lo; n],
                 ),
                 (Method::Cov, Some(_)) => {
-                    let filters = guard_filters(&cands, film, s.spp);
+                    let gd = guarded(&cands, film, s.spp);
                     let keep = (s.spp.floor() as u32).max(lo);
-                    filters
+                    gd.filters
                         .iter()
                         .zip(&rv)
                         .map(|(f, r)| match f {
