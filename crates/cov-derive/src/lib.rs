@@ -320,7 +320,7 @@ fn expand(input: &DeriveInput) -> syn::Result<Tokens> {
             let mut fmt = format!("must be {}", domain_text(f));
             let mut args = Vec::new();
             for (_, b) in &f.bounds {
-                if !is_literal(b) {
+                if !is_literal(b) && bound_text(b) != "π" {
                     fmt.push_str(&format!(" ({} = {{}})", bound_text(b)));
                     args.push(b.clone());
                 }
