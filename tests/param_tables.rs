@@ -36,21 +36,23 @@ fn check(crate_dir: &str, register: Register) -> Result<(), String> {
     ))
 }
 
+/// Every operator crate, with its `spec::register`.
+const CRATES: [(&str, Register); 10] = [
+    ("cov-travel", covtrace::travel::spec::register),
+    ("cov-occlusion", covtrace::occlusion::spec::register),
+    ("cov-projection", covtrace::projection::spec::register),
+    ("cov-curvature", covtrace::curvature::spec::register),
+    ("cov-brdf", covtrace::brdf::spec::register),
+    ("cov-refraction", covtrace::refraction::spec::register),
+    ("cov-motion", covtrace::motion::spec::register),
+    ("cov-defocus", covtrace::defocus::spec::register),
+    ("cov-sensor", covtrace::sensor::spec::register),
+    ("cov-media", covtrace::media::spec::register),
+];
+
 #[test]
 fn crate_docs_show_the_generated_parameter_tables() {
-    let crates: [(&str, Register); 10] = [
-        ("cov-travel", covtrace::travel::spec::register),
-        ("cov-occlusion", covtrace::occlusion::spec::register),
-        ("cov-projection", covtrace::projection::spec::register),
-        ("cov-curvature", covtrace::curvature::spec::register),
-        ("cov-brdf", covtrace::brdf::spec::register),
-        ("cov-refraction", covtrace::refraction::spec::register),
-        ("cov-motion", covtrace::motion::spec::register),
-        ("cov-defocus", covtrace::defocus::spec::register),
-        ("cov-sensor", covtrace::sensor::spec::register),
-        ("cov-media", covtrace::media::spec::register),
-    ];
-    let errors: Vec<String> = crates.iter().filter_map(|(d, r)| check(d, *r).err()).collect();
+    let errors: Vec<String> = CRATES.iter().filter_map(|(d, r)| check(d, *r).err()).collect();
     assert!(errors.is_empty(), "{}", errors.join("\n\n"));
 }
 
@@ -72,20 +74,8 @@ fn every_parameter_is_documented_with_a_unit_or_a_reason_not_to() {
 /// the derive's generated checks), so a renamed field cannot leave a stale name behind.
 #[test]
 fn no_operator_crate_spells_a_parameter_name_in_a_string() {
-    let crates: [(&str, Register); 10] = [
-        ("cov-travel", covtrace::travel::spec::register),
-        ("cov-occlusion", covtrace::occlusion::spec::register),
-        ("cov-projection", covtrace::projection::spec::register),
-        ("cov-curvature", covtrace::curvature::spec::register),
-        ("cov-brdf", covtrace::brdf::spec::register),
-        ("cov-refraction", covtrace::refraction::spec::register),
-        ("cov-motion", covtrace::motion::spec::register),
-        ("cov-defocus", covtrace::defocus::spec::register),
-        ("cov-sensor", covtrace::sensor::spec::register),
-        ("cov-media", covtrace::media::spec::register),
-    ];
     let mut found = Vec::new();
-    for (dir, register) in crates {
+    for (dir, register) in CRATES {
         let mut c = Catalogue::default();
         register(&mut c);
         let names: Vec<&str> = c
