@@ -130,9 +130,9 @@ fn one_line_usage_error(e: &clap::Error) -> String {
 
 /// Runs the `covtrace` command line on this process's arguments, with the built-in
 /// operators and those `register` adds: a third party's `main` is
-/// `fn main() -> std::process::ExitCode { crate::run_with(|r| my_ops::register(r)) }`
-/// and gets `eval`, `plot`, `list`, `validate` (and the rest) with its operators next to
-/// the built-in ones, with covtrace's output and one-line errors (exit code 2).
+/// `fn main() -> std::process::ExitCode { cov_cli::run_with(my_ops::register) }`
+/// and gets `eval`, `plot` and `list` (and the rest) with its operators next to the
+/// built-in ones, with covtrace's output and one-line errors (exit code 2).
 pub fn run_with(register: impl FnOnce(&mut Registry)) -> ExitCode {
     let cli = match Cli::try_parse() {
         Ok(cli) => cli,
@@ -246,7 +246,11 @@ fn run(cli: Cli, registry: &Registry) -> Result<(), String> {
                     say!("    (no parameters: write `{0}` or `{0}()`)", e.name);
                 }
                 for p in e.params {
-                    let default = p.default.map(|d| format!(" (default {d})")).unwrap_or_default();
+                    let default = match p.default {
+                        None => String::new(),
+                        Some(covtrace::spec::OPTIONAL) => " (optional)".to_string(),
+                        Some(d) => format!(" (default {d})"),
+                    };
                     let unit = if p.unit.is_empty() { "–" } else { p.unit };
                     let domain = if p.domain.is_empty() { "–" } else { p.domain };
                     say!(

@@ -37,9 +37,18 @@
 //! every parameter is optional), errors positioned at the parameter as written
 //! (`file:line:column`, for unknown, repeated, missing and out-of-domain parameters), the
 //! parameter table of `covtrace list` and of the docs (name, unit, default, domain,
-//! meaning), `eval`/`plot`/`validate` through `covtrace_cli::run_with`, and the checked
-//! constructor for Rust callers ([`OperatorSpec::build`]: an operator's `new` is
-//! `MySpec { … }.build()`, the same checks as a file's).
+//! meaning), `eval`, `plot` and `list` from a `main` of one line,
+//! `cov_cli::run_with(my_ops::register)` (crate `cov-cli`), and the checked constructor
+//! for Rust callers ([`OperatorSpec::build`]: an operator's `new` is `MySpec { … }.build()`,
+//! the same checks as a file's).
+//!
+//! **Good to know**: an operator is `Debug + Send + Sync` (it is shared across threads);
+//! tables and runtime errors name a step by [`Operator::name`], the Rust type's name
+//! unless you override it (return the spec's name when the two differ); a parameter
+//! without `unit` is dimensionless (`–` in tables); a derived quantity that can overflow
+//! (a window's `1/(4π² s²)`, with [`FOUR_PI_SQ`](crate::FOUR_PI_SQ)) is checked in
+//! `make` and reported on the parameter the user wrote, `MySpec::RADIUS.error(value,
+//! "too small: …")`, rather than left to the kernel, which would name its own argument.
 //!
 //! Nothing here knows a file format: the format crate (`cov-path`, RON) drives
 //! [`OperatorSpec::deserialize_in`] with its own deserializer and an [`OperatorReader`]

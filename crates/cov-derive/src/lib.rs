@@ -23,7 +23,7 @@
 
 use proc_macro::TokenStream;
 use proc_macro2::TokenStream as Tokens;
-use quote::{format_ident, quote};
+use quote::{format_ident, quote, quote_spanned};
 use syn::{Data, DeriveInput, Expr, Fields, Ident, LitStr, spanned::Spanned};
 
 /// Derives `cov_core::OperatorSpec` for a struct of named parameters.
@@ -176,9 +176,9 @@ fn expand(input: &DeriveInput) -> syn::Result<Tokens> {
             if m.path.is_ident("name") {
                 name = m.value()?.parse::<LitStr>()?.value();
             } else if m.path.is_ident("op") {
-                return Err(m.error(
-                    "`op` is not needed: name the operator type in `impl Build for ThisSpec { type Op = YourOperator; … }`",
-                ));
+                return Err(m.error(format!(
+                    "`op` is not needed: name the operator type in `impl Build for {ty} {{ type Op = YourOperator; … }}`"
+                )));
             } else if m.path.is_ident("summary") {
                 summary = Some(m.value()?.parse::<LitStr>()?.value());
             } else {
@@ -325,8 +325,11 @@ fn expand(input: &DeriveInput) -> syn::Result<Tokens> {
                     args.push(b.clone());
                 }
             }
+            // Spanned at the field's type: a domain on a type without one is reported there.
+            let fty = &f.ty;
+            let call = quote_spanned!(fty.span()=> <#fty as #core::ParamValue>::check_param);
             quote! {
-                #core::ParamValue::check_param(
+                #call(
                     &self.#id,
                     &#ty::#c,
                     |__v: f64| true #(&& #conds)*,

@@ -2,5 +2,5 @@
 //! built-in ones: `cargo run -- eval glitter.ron`, `-- list`, `-- plot glitter.ron -o g.png`.
 
 fn main() -> std::process::ExitCode {
-    cov_cli::run_with(|r| covtrace_sparkle::register(r))
+    cov_cli::run_with(covtrace_sparkle::register)
 }
