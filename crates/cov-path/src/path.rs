@@ -41,6 +41,12 @@ fn explain(text: &str, line: usize, col: usize, code: &ron::Error) -> (usize, us
         Some((op, rest)) if !op.contains(' ') => (format!("{op}: "), rest.to_string()),
         _ => (String::new(), msg.clone()),
     };
+    // An operator's parameters in the path author's words rather than the parser's.
+    if !prefix.is_empty()
+        && let Some(words) = parameter_words(&rest)
+    {
+        return (line, col, format!("{prefix}{words}"));
+    }
     if let Some(tail) = rest.strip_prefix("Found invalid std identifier \"") {
         let found = tail.split('"').next().unwrap_or("");
         return (
@@ -87,6 +93,28 @@ fn explain(text: &str, line: usize, col: usize, code: &ron::Error) -> (usize, us
         return (l, c, msg);
     }
     (line, col, msg)
+}
+
+/// ron's messages about a struct's fields, said of an operator's parameters: missing,
+/// unknown (with the ones it takes) and repeated. `None` for any other message.
+fn parameter_words(rest: &str) -> Option<String> {
+    let name_after = |prefix: &str| rest.strip_prefix(prefix).and_then(|t| t.split_once('`'));
+    if let Some((name, _)) = name_after("Unexpected missing field named `") {
+        return Some(format!("missing parameter `{name}`"));
+    }
+    if let Some((name, _)) = name_after("Unexpected duplicate field named `") {
+        return Some(format!("parameter `{name}` is given twice"));
+    }
+    let (name, after) = name_after("Unexpected field named `")?;
+    if after.contains("there are no fields") {
+        return Some(format!("unknown parameter `{name}`: this operator takes none"));
+    }
+    let expected = after.strip_suffix(" instead")?;
+    if let Some(list) = expected.strip_prefix(", expected one of ") {
+        return Some(format!("unknown parameter `{name}`; the parameters are {list}"));
+    }
+    let one = expected.strip_prefix(", expected ")?;
+    Some(format!("unknown parameter `{name}`; the parameter is {one}"))
 }
 
 impl Path {
