@@ -65,10 +65,34 @@ struct FieldSpec {
     doc: String,
     default: Option<Option<Expr>>,
     nested: bool,
-    /// Declared bounds: (`>`, `≥`, `<` or `≤`, the bound).
-    bounds: Vec<(&'static str, Expr)>,
+    /// Declared bounds: at most one lower and one upper.
+    bounds: Vec<(Bound, Expr)>,
     /// Checked at all: a declared domain, or a float type.
     checked: bool,
+}
+
+/// A declared bound's kind.
+#[derive(Clone, Copy, PartialEq)]
+enum Bound {
+    Gt,
+    Ge,
+    Lt,
+    Le,
+}
+
+impl Bound {
+    fn is_lower(self) -> bool {
+        matches!(self, Bound::Gt | Bound::Ge)
+    }
+
+    fn symbol(self) -> &'static str {
+        match self {
+            Bound::Gt => ">",
+            Bound::Ge => "≥",
+            Bound::Lt => "<",
+            Bound::Le => "≤",
+        }
+    }
 }
 
 /// `0` as `0.0`: bounds are compared as f64.
@@ -125,17 +149,17 @@ fn domain_text(f: &FieldSpec) -> String {
     if !f.checked {
         return String::new();
     }
-    let lower = f.bounds.iter().find(|(k, _)| *k == ">" || *k == "≥");
-    let upper = f.bounds.iter().find(|(k, _)| *k == "<" || *k == "≤");
+    let lower = f.bounds.iter().find(|(k, _)| k.is_lower());
+    let upper = f.bounds.iter().find(|(k, _)| !k.is_lower());
     match (lower, upper) {
         (Some((lk, l)), Some((uk, u))) => format!(
             "in {}{}, {}{}",
-            if *lk == ">" { "(" } else { "[" },
+            if *lk == Bound::Gt { "(" } else { "[" },
             bound_text(l),
             bound_text(u),
-            if *uk == "<" { ")" } else { "]" }
+            if *uk == Bound::Lt { ")" } else { "]" }
         ),
-        (Some((k, b)), None) | (None, Some((k, b))) => format!("{k} {}", bound_text(b)),
+        (Some((k, b)), None) | (None, Some((k, b))) => format!("{} {}", k.symbol(), bound_text(b)),
         (None, None) => "finite".to_string(),
     }
 }
@@ -238,9 +262,10 @@ fn expand(input: &DeriveInput) -> syn::Result<Tokens> {
                     .iter()
                     .position(|k| m.path.is_ident(k))
                 {
-                    let kind = [">", "≥", "<", "≤", ">", "≥"][k];
-                    let lower = kind == ">" || kind == "≥";
-                    if bounds.iter().any(|(b, _)| (*b == ">" || *b == "≥") == lower) {
+                    use Bound::{Ge, Gt, Le, Lt};
+                    let kind = [Gt, Ge, Lt, Le, Gt, Ge][k];
+                    let lower = kind.is_lower();
+                    if bounds.iter().any(|(b, _): &(Bound, Expr)| b.is_lower() == lower) {
                         return Err(m.error(if lower {
                             "a second lower bound: give one of `positive`, `non_negative`, `gt`, `ge`"
                         } else {
@@ -312,16 +337,18 @@ fn expand(input: &DeriveInput) -> syn::Result<Tokens> {
         .map(|(f, c)| {
             let id = &f.ident;
             let conds = f.bounds.iter().map(|(k, b)| match *k {
-                ">" => quote!(__v > (#b)),
-                "≥" => quote!(__v >= (#b)),
-                "<" => quote!(__v < (#b)),
-                _ => quote!(__v <= (#b)),
+                Bound::Gt => quote!(__v > (#b)),
+                Bound::Ge => quote!(__v >= (#b)),
+                Bound::Lt => quote!(__v < (#b)),
+                Bound::Le => quote!(__v <= (#b)),
             });
-            let mut fmt = format!("must be {}", domain_text(f));
+            // A format string: braces in a bound's text are escaped.
+            let esc = |t: String| t.replace('{', "{{").replace('}', "}}");
+            let mut fmt = format!("must be {}", esc(domain_text(f)));
             let mut args = Vec::new();
             for (_, b) in &f.bounds {
                 if !is_literal(b) && bound_text(b) != "π" {
-                    fmt.push_str(&format!(" ({} = {{}})", bound_text(b)));
+                    fmt.push_str(&format!(" ({} = {{}})", esc(bound_text(b))));
                     args.push(b.clone());
                 }
             }
