@@ -3,32 +3,25 @@
 //! parameters; compare ratios within one run (`cargo bench --bench chain`).
 //!
 //! - `chain/op/N=4`: each operator of the bounce chain, built per ray and applied to
-//!   `Cov<4>` and `CovFactor<4>` (checked: parameters, axes, overflow), next to the
-//!   baseline's update: through `Operator::apply` (`&mut dyn Spectrum`, as a chain or
-//!   plugin calls it) and through the operator's typed body (`apply_to`, the spectrum's
-//!   type known at the call: "typed").
+//!   `Cov<4>` and `CovFactor<4>` through `Operator::apply` (checked: parameters, axes,
+//!   overflow), next to the baseline's update.
 //! - `chain/bounce/N=2|4|5`: the 10-operator bounce chain (travel, projection from
 //!   vectors, curvature, mirror, Phong lobe, curvature back, unprojection, rotation,
 //!   travel, window; at N = 2 the rotations are identities). Per-ray parameters: the
-//!   baseline; operators built per ray and applied checked, through `Operator::apply`
-//!   and through their typed bodies; the same recorded on a
-//!   reused `Tape` and run. Fixed parameters: the baseline with coefficients computed
-//!   once; the public `Chain::apply` (compiled tape); `Chain::eval_batch` on one core
-//!   and on every core; `Chain::eval_lanes` on the same states stored
-//!   structure-of-arrays ([`CovLanes`]). Per-ray parameters, batched: `eval_batch_with` building and
-//!   applying each state's operators, on one core and on every core, and
-//!   `eval_batch_typed` applying them through their typed bodies (`StateOps`), next to
-//!   the per-ray baseline over the same 4,096 states.
+//!   baseline; the operators built per ray and applied one by one through
+//!   `Operator::apply` (each kernel checked), and pushed on a `Chain` built per ray and
+//!   applied (the unchecked kernels, one finiteness check at the end: what the renderer
+//!   does). Fixed parameters: the baseline with coefficients computed once, and one
+//!   `Chain` applied to every state.
 
 use std::f64::consts::PI;
 use std::hint::black_box;
-use std::time::{Duration, Instant};
 
 use covtrace::brdf::{Brdf, Lobe};
 use covtrace::curvature::Curvature;
 use covtrace::projection::{Mirror, Project, RotateFrame};
 use covtrace::travel::Travel;
-use covtrace::{Cov, CovError, CovFactor, CovLanes, Form, Operator, Spectrum, StateOps, Tape};
+use covtrace::{Cov, CovFactor, Operator};
 use criterion::{BatchSize, Bencher, Criterion, Throughput, criterion_group, criterion_main};
 use glam::DVec3;
 use rand::{Rng, SeedableRng};
@@ -41,7 +34,7 @@ mod common;
 mod ops;
 use baseline::{Fixed, Packed, Ray};
 use common::{BATCH, random_covs};
-use ops::{Ops, Shared};
+use ops::Ops;
 
 fn unit(rng: &mut ChaCha8Rng) -> DVec3 {
     loop {
@@ -80,20 +73,6 @@ fn rays(rng: &mut ChaCha8Rng) -> Vec<Ray> {
             }
         })
         .collect()
-}
-
-/// Each ray's operators, built per state and applied through their typed bodies: the
-/// per-state operators of `eval_batch_typed`.
-struct PerRay<'a> {
-    rays: &'a [Ray],
-    n: usize,
-}
-
-impl StateOps for PerRay<'_> {
-    #[inline(always)]
-    fn apply<S: Spectrum>(&self, i: usize, s: &mut S) -> Result<(), CovError> {
-        Ops::new(&self.rays[i % self.rays.len()], self.n).try_typed(s)
-    }
 }
 
 fn packed<const N: usize>(c: &Cov<N>) -> Packed<N> {
@@ -144,29 +123,6 @@ fn packs<const N: usize>(covs: &[Cov<N>]) -> Vec<Packed<N>> {
     covs.iter().map(packed).collect()
 }
 
-/// Times `run` on a fresh copy of `input` inside `pool` (the copy outside the timing, a
-/// whole sample per `install`: what is timed is the batch, not handing it to a thread).
-fn in_pool<T: Clone + Sync>(
-    b: &mut Bencher<'_>,
-    pool: &rayon::ThreadPool,
-    input: &T,
-    run: &(dyn Fn(&mut T) -> usize + Sync),
-) {
-    b.iter_custom(|iters| {
-        pool.install(|| {
-            let mut total = Duration::ZERO;
-            for _ in 0..iters {
-                let mut states = input.clone();
-                let t = Instant::now();
-                black_box(run(&mut states));
-                total += t.elapsed();
-                black_box(&states);
-            }
-            total
-        })
-    })
-}
-
 fn ops(c: &mut Criterion, rng: &mut ChaCha8Rng) {
     let covs = random_covs::<4>(rng);
     let facs: Vec<CovFactor<4>> = covs.iter().map(CovFactor::from_cov).collect();
@@ -192,18 +148,6 @@ fn ops(c: &mut Criterion, rng: &mut ChaCha8Rng) {
                 each(b, &facs, |i, x| {
                     let $rr = &rays[i];
                     let _ = black_box($lib.apply(x));
-                })
-            });
-            g.bench_function(concat!($name, ": Cov<4> typed"), |b| {
-                each(b, &covs, |i, x| {
-                    let $rr = &rays[i];
-                    let _ = black_box($lib.apply_to(x));
-                })
-            });
-            g.bench_function(concat!($name, ": CovFactor<4> typed"), |b| {
-                each(b, &facs, |i, x| {
-                    let $rr = &rays[i];
-                    let _ = black_box($lib.apply_to(x));
                 })
             });
         };
@@ -253,47 +197,26 @@ fn bounce_n<const N: usize>(c: &mut Criterion, rng: &mut ChaCha8Rng) {
     g.bench_function("per-ray: baseline", |b| {
         each(b, &base, |i, p| baseline::bounce(p, &rays[i]))
     });
-    g.bench_function("per-ray: operators applied (covariance)", |b| {
+    g.bench_function("per-ray: Operator::apply (covariance)", |b| {
         each(b, &covs, |i, x| {
             black_box(Ops::new(&rays[i], N).apply(x));
         })
     });
-    g.bench_function("per-ray: operators applied (square root)", |b| {
+    g.bench_function("per-ray: Operator::apply (square root)", |b| {
         each(b, &facs, |i, x| {
             black_box(Ops::new(&rays[i], N).apply(x));
         })
     });
-    g.bench_function("per-ray: operators typed (covariance)", |b| {
+    g.bench_function("per-ray: Chain::apply (covariance)", |b| {
         each(b, &covs, |i, x| {
-            black_box(Ops::new(&rays[i], N).apply_typed(x));
+            black_box(Ops::new(&rays[i], N).chain().apply(x).is_ok());
         })
     });
-    g.bench_function("per-ray: operators typed (square root)", |b| {
+    g.bench_function("per-ray: Chain::apply (square root)", |b| {
         each(b, &facs, |i, x| {
-            black_box(Ops::new(&rays[i], N).apply_typed(x));
+            black_box(Ops::new(&rays[i], N).chain().apply(x).is_ok());
         })
     });
-    for (name, form) in [
-        ("covariance", Form::Covariance),
-        ("square root", Form::SquareRoot),
-    ] {
-        g.bench_function(format!("per-ray: recorded on a Tape ({name})"), |b| {
-            let mut tape = Tape::new(N, form).expect("layout");
-            each(b, &covs, |i, x| {
-                tape.clear();
-                let ops = Ops::new(&rays[i], N);
-                for op in ops.list().into_iter().flatten() {
-                    tape.record(op).expect("recordable");
-                }
-                match form {
-                    Form::Covariance => *x = tape.run_cov(*x).unwrap_or(*x),
-                    Form::SquareRoot => {
-                        black_box(tape.run_factor(facs[i]));
-                    }
-                }
-            })
-        });
-    }
     let fixed = Fixed::new(&rays[0]);
     g.bench_function("fixed: baseline", |b| each(b, &base, |_, p| fixed.run(p)));
     let chain = Ops::new(&rays[0], N).chain();
@@ -306,77 +229,6 @@ fn bounce_n<const N: usize>(c: &mut Criterion, rng: &mut ChaCha8Rng) {
         each(b, &facs, |_, x| {
             black_box(chain.apply(x).is_ok());
         })
-    });
-    // Batches: 4,096 states per call (16 × the scalar rows' 256; compare throughputs).
-    let many: Vec<Cov<N>> = (0..16).flat_map(|_| covs.iter().copied()).collect();
-    let many_base = packs(&many);
-    g.throughput(Throughput::Elements(many.len() as u64));
-    // Batches run inside a pool (one worker, or one per core), a whole sample per
-    // `install`: what is timed is the batch, not handing it to another thread.
-    let pool = |threads| {
-        rayon::ThreadPoolBuilder::new()
-            .num_threads(threads)
-            .build()
-            .expect("pool")
-    };
-    let pools = [("1 thread", pool(1)), ("all threads", pool(0))];
-    let batch =
-        |b: &mut Bencher<'_>, pool: &rayon::ThreadPool, run: &(dyn Fn(&mut Vec<Cov<N>>) -> usize + Sync)| {
-            in_pool(b, pool, &many, run)
-        };
-    for (name, form) in [
-        ("covariance", Form::Covariance),
-        ("square root", Form::SquareRoot),
-    ] {
-        for (threads, p) in &pools {
-            g.bench_function(format!("fixed: Chain::eval_batch ({name}, {threads})"), |b| {
-                batch(b, p, &|s| chain.eval_batch(form, s).len())
-            });
-        }
-    }
-    // The same fixed operators through their typed bodies (no tape).
-    let shared = Shared(Ops::new(&rays[0], N));
-    for (name, form) in [
-        ("covariance", Form::Covariance),
-        ("square root", Form::SquareRoot),
-    ] {
-        for (threads, p) in &pools {
-            g.bench_function(format!("fixed: eval_batch_typed ({name}, {threads})"), |b| {
-                batch(b, p, &|s| covtrace::eval_batch_typed(form, s, &shared).len())
-            });
-        }
-    }
-    // The same states stored structure-of-arrays: the batch without its transpositions.
-    let many_lanes: CovLanes<N> = many.iter().copied().collect();
-    for (threads, p) in &pools {
-        g.bench_function(format!("fixed: Chain::eval_lanes (covariance, {threads})"), |b| {
-            in_pool(b, p, &many_lanes, &|s| chain.eval_lanes(s).len())
-        });
-    }
-    // Per-ray parameters, batched: each state's operators built and applied in parallel.
-    for (name, form) in [
-        ("covariance", Form::Covariance),
-        ("square root", Form::SquareRoot),
-    ] {
-        let per_ray =
-            |i: usize, s: &mut dyn covtrace::Spectrum| Ops::new(&rays[i % rays.len()], N).try_dyn(s);
-        for (threads, p) in &pools {
-            g.bench_function(format!("per-ray: eval_batch_with ({name}, {threads})"), |b| {
-                batch(b, p, &|s| covtrace::eval_batch_with(form, s, per_ray).len())
-            });
-        }
-        let typed = PerRay { rays: &rays, n: N };
-        for (threads, p) in &pools {
-            g.bench_function(format!("per-ray: eval_batch_typed ({name}, {threads})"), |b| {
-                batch(b, p, &|s| covtrace::eval_batch_typed(form, s, &typed).len())
-            });
-        }
-    }
-    g.bench_function("per-ray: baseline (4,096 states)", |b| {
-        each(b, &many_base, |i, p| baseline::bounce(p, &rays[i % rays.len()]))
-    });
-    g.bench_function("fixed: baseline (4,096 states)", |b| {
-        each(b, &many_base, |_, p| fixed.run(p))
     });
     g.finish();
 }

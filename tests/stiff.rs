@@ -28,25 +28,6 @@ fn stiff_suite() {
         let err = o
             .ours
             .unwrap_or_else(|| panic!("{}: ours failed: {:?}", o.name, o.ours_error));
-        // The compiled path (the chain's second evaluation) is held to the same bounds,
-        // or to its checked evaluation's error where that is above them (reported cases).
-        let (c_sqrt, c_cov) = o.compiled;
-        let c_sqrt = c_sqrt.unwrap_or_else(|| panic!("{}: compiled square root failed or not PSD", o.name));
-        assert!(
-            c_sqrt <= err.max(1e-9),
-            "{}: compiled square root {c_sqrt:e} > {err:e}",
-            o.name
-        );
-        if let Some(cov) = o.ours_cov {
-            let c_cov = c_cov.unwrap_or_else(|| panic!("{}: compiled covariance failed or not PSD", o.name));
-            let limit = if o.ops >= 1000 { 1e-8 } else { 1e-9 };
-            assert!(
-                c_cov <= cov.max(limit),
-                "{}: compiled covariance {c_cov:e} > {:e}",
-                o.name,
-                cov.max(limit)
-            );
-        }
         assert!(err.is_finite(), "{}", o.name);
         let cov = o
             .ours_cov

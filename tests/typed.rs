@@ -1,15 +1,18 @@
-//! The operators' typed bodies (`apply_to`, the spectrum's type known at the call, so
-//! the kernels inline with constant indices) against `Operator::apply` (`&mut dyn
-//! Spectrum`): on random sequences of the bounce chain's operators with random
-//! parameters, in both forms and all four layouts, the same bits after every step, the
-//! same errors (missing axis, overflow) and the same Σ after an error.
+//! `Operator::apply` on a `Cov<N>` or `CovFactor<N>`, where the bundled operators run
+//! their body with the spectrum's type known (`cov_core::typed!`: kernels inlined with
+//! constant indices), against the same operators on a spectrum that hides its type (a
+//! third party's `Spectrum`, where the body runs through `&mut dyn Spectrum`): on random
+//! sequences of the bounce chain's operators with random parameters, in both forms and
+//! all four layouts, the same bits after every step, the same errors (missing axis,
+//! overflow) and the same Σ after an error.
 
 use covtrace::brdf::{Brdf, Lobe};
 use covtrace::curvature::{Curvature, CurvatureTensor};
+use covtrace::linalg::Small;
 use covtrace::occlusion::Window;
 use covtrace::projection::{Mirror, Project, RotateFrame, Unproject};
 use covtrace::travel::Travel;
-use covtrace::{Cov, CovError, CovFactor, Operator, Spectrum};
+use covtrace::{AnyCov, AnySpectrum, Cov, CovError, CovFactor, Form, Operator, Spectrum};
 use proptest::prelude::*;
 
 /// One operator with parameters from `(kind, p, q)`; `None` where the constructor
@@ -73,29 +76,68 @@ fn dyn_op(op: &Op) -> &dyn Operator {
     }
 }
 
-fn typed<S: Spectrum>(op: &Op, s: &mut S) -> Result<(), CovError> {
-    match op {
-        Op::Travel(o) => o.apply_to(s),
-        Op::Curvature(o) => o.apply_to(s),
-        Op::Tensor(o) => o.apply_to(s),
-        Op::Project(o) => o.apply_to(s),
-        Op::Unproject(o) => o.apply_to(s),
-        Op::Mirror => Mirror.apply_to(s),
-        Op::Rotate(o) => o.apply_to(s),
-        Op::Brdf(o) => o.apply_to(s),
-        Op::Window(o) => o.apply_to(s),
+/// A spectrum that hides its concrete type ([`Spectrum::concrete`] is `Other`), as a
+/// third party's would: operators run their body through `&mut dyn Spectrum`.
+#[derive(Debug)]
+struct Opaque<'a>(&'a mut dyn Spectrum);
+
+impl Spectrum for Opaque<'_> {
+    fn dim(&self) -> usize {
+        self.0.dim()
+    }
+    fn form(&self) -> Form {
+        self.0.form()
+    }
+    fn cov(&self) -> Result<AnyCov, CovError> {
+        self.0.cov()
+    }
+    fn assign(&mut self, c: &AnyCov) -> Result<(), CovError> {
+        self.0.assign(c)
+    }
+    fn snapshot(&self) -> AnySpectrum {
+        self.0.snapshot()
+    }
+    fn restore(&mut self, s: &AnySpectrum) {
+        self.0.restore(s)
+    }
+    fn first_non_finite(&self) -> Option<(usize, usize, f64)> {
+        self.0.first_non_finite()
+    }
+    fn raw_congruence(&mut self, op: &str, a: &Small) -> Result<(), CovError> {
+        self.0.raw_congruence(op, a)
+    }
+    fn raw_shear(&mut self, op: &str, i: usize, j: usize, s: f64) -> Result<(), CovError> {
+        self.0.raw_shear(op, i, j, s)
+    }
+    fn raw_scale(&mut self, op: &str, i: usize, c: f64) -> Result<(), CovError> {
+        self.0.raw_scale(op, i, c)
+    }
+    fn raw_rotate(&mut self, op: &str, planes: &[(usize, usize)], c: f64, s: f64) -> Result<(), CovError> {
+        self.0.raw_rotate(op, planes, c, s)
+    }
+    fn raw_add_window(&mut self, op: &str, p: &[usize], w: &Small) -> Result<(), CovError> {
+        self.0.raw_add_window(op, p, w)
+    }
+    fn raw_add_variance(&mut self, op: &str, i: usize, w: f64) -> Result<(), CovError> {
+        self.0.raw_add_variance(op, i, w)
+    }
+    fn raw_lobe_1(&mut self, op: &str, p: usize, s: f64) -> Result<(), CovError> {
+        self.0.raw_lobe_1(op, p, s)
+    }
+    fn raw_lobe(&mut self, op: &str, p: &[usize], s: &Small) -> Result<(), CovError> {
+        self.0.raw_lobe(op, p, s)
     }
 }
 
 /// Runs `ops` both ways on `start` and compares after every step; returns how many
 /// steps failed (so that the caller can see that error paths were reached).
-fn both<S: Spectrum + Copy + PartialEq + std::fmt::Debug>(start: S, ops: &[Op]) -> usize {
+fn both<S: Spectrum + Copy + 'static + PartialEq + std::fmt::Debug>(start: S, ops: &[Op]) -> usize {
     let (mut a, mut b) = (start, start);
     // After an error both go on from the Σ the failed operator left (the same, checked).
     let mut failed = 0;
     for (k, op) in ops.iter().enumerate() {
-        let ra = typed(op, &mut a);
-        let rb = dyn_op(op).apply(&mut b);
+        let ra = dyn_op(op).apply(&mut a);
+        let rb = dyn_op(op).apply(&mut Opaque(&mut b));
         assert_eq!(
             ra.as_ref().map_err(ToString::to_string),
             rb.as_ref().map_err(ToString::to_string),
@@ -156,78 +198,4 @@ fn typed_bodies_report_the_same_errors() {
     assert_eq!(both(c, &[far, far]), 2, "Σ_uu = 1e400 overflows");
     // The factor holds √Σ: its rows reach 1e200 and stay finite.
     assert_eq!(both(CovFactor::from_cov(&c), &[far, far]), 0);
-}
-
-/// Per-state operators for the typed batch: state `i` runs `chains[i]`.
-struct Chains(Vec<Vec<Op>>);
-
-impl covtrace::StateOps for Chains {
-    fn apply<S: Spectrum>(&self, i: usize, s: &mut S) -> Result<(), CovError> {
-        self.0[i].iter().try_for_each(|op| typed(op, s))
-    }
-}
-
-/// `eval_batch_typed` (typed bodies on the unchecked kernels, checked re-run on failure)
-/// gives `eval_batch_with`'s results (operators through `dyn Spectrum`): the same bits,
-/// the same failing states with the same messages, and failed states left as they were.
-fn batches_agree<const N: usize>(d: &[f64], chains: &Chains) -> usize {
-    use covtrace::Form;
-    let mut failed = 0;
-    for form in [Form::Covariance, Form::SquareRoot] {
-        let start: Vec<Cov<N>> = (0..chains.0.len()).map(|i| start::<N>(&d[i % 3..])).collect();
-        let (mut a, mut b) = (start.clone(), start.clone());
-        let fa = covtrace::eval_batch_typed(form, &mut a, chains);
-        let fb = covtrace::eval_batch_with(form, &mut b, |i, s| {
-            chains.0[i].iter().try_for_each(|op| dyn_op(op).apply(s))
-        });
-        // A state left non-finite with no operator error is reported under the batch's
-        // own name, which differs between the two; everything else must be identical.
-        let text = |f: &[(usize, CovError)]| {
-            f.iter()
-                .map(|(i, e)| (*i, e.to_string().replace("eval_batch_typed", "eval_batch_with")))
-                .collect::<Vec<_>>()
-        };
-        assert_eq!(text(&fa), text(&fb), "{form:?}: failures differ");
-        assert_eq!(a, b, "{form:?}: typed and dynamic batches differ");
-        for (i, _) in &fa {
-            assert_eq!(a[*i], start[*i], "{form:?}: failed state {i} was changed");
-        }
-        failed += fa.len();
-    }
-    failed
-}
-
-proptest! {
-    #![proptest_config(ProptestConfig::with_cases(40))]
-
-    #[test]
-    fn typed_batch_matches_closure_batch(
-        d in prop::collection::vec(prop_oneof![Just(0.0), 1e-3f64..10.0], 8),
-        o in prop::collection::vec(ops(), 1..40),
-    ) {
-        let chains = Chains(
-            o.iter()
-                .map(|c| c.iter().filter_map(|&(k, p, q)| op_of(k, p, q)).collect())
-                .collect(),
-        );
-        batches_agree::<2>(&d, &chains);
-        batches_agree::<4>(&d, &chains);
-        batches_agree::<5>(&d, &chains);
-    }
-}
-
-/// The typed batch reaches its error paths: states that overflow and states whose layout
-/// lacks an axis fail, with the checked kernels' messages, among states that succeed.
-#[test]
-fn typed_batch_reports_failing_states() {
-    let rotate = op_of(7, 0.4, 0.0).expect("valid");
-    let far = Op::Travel(Travel::new(1e200).expect("finite"));
-    let near = Op::Travel(Travel::new(0.5).expect("finite"));
-    let chains = Chains(vec![vec![near], vec![far, far], vec![near, rotate], vec![near]]);
-    // Flatland: the rotation needs y and v (state 2); Σ_uu = 1e400 overflows in
-    // covariance form (state 1), while the factor's rows stay finite but Σ = L Lᵀ
-    // does not (reported when the factor is turned back into Σ).
-    assert_eq!(batches_agree::<2>(&[1.0; 8], &chains), 4);
-    // 4D has the rotation's axes: only the overflow fails, in both forms.
-    assert_eq!(batches_agree::<4>(&[1.0; 8], &chains), 2);
 }

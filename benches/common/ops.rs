@@ -1,15 +1,14 @@
 //! The bounce chain's 10 library operators for one ray (`baseline::Ray`), shared by
 //! `benches/chain.rs` and `tools/chain-probe`: travel, projection from vectors,
 //! curvature, mirror, Phong lobe, curvature back, unprojection, frame rotation (N ≥ 4),
-//! travel, window; applied through `Operator::apply`, through their typed bodies, or
-//! pushed on a `Chain`.
+//! travel, window; applied one by one through `Operator::apply`, or pushed on a `Chain`.
 
 use covtrace::brdf::{Brdf, Lobe};
 use covtrace::curvature::Curvature;
 use covtrace::occlusion::Window;
 use covtrace::projection::{Mirror, Project, RotateFrame, Unproject};
 use covtrace::travel::Travel;
-use covtrace::{Chain, CovError, Operator, Spectrum, StateOps};
+use covtrace::{Chain, CovError, Operator, Spectrum};
 use glam::DVec3;
 
 use crate::baseline::Ray;
@@ -80,30 +79,6 @@ impl Ops {
         self.list().into_iter().flatten().try_for_each(|op| op.apply(s))
     }
 
-    /// The same operators through their typed bodies (`apply_to`): the spectrum's type
-    /// is known here, so the kernels inline with constant indices.
-    #[inline(always)]
-    pub fn apply_typed<S: Spectrum>(&self, s: &mut S) -> bool {
-        self.try_typed(s).is_ok()
-    }
-
-    /// [`Ops::apply_typed`] with the first error.
-    #[inline(always)]
-    pub fn try_typed<S: Spectrum>(&self, s: &mut S) -> Result<(), CovError> {
-        self.t1.apply_to(s)?;
-        self.project.apply_to(s)?;
-        self.k.apply_to(s)?;
-        Mirror.apply_to(s)?;
-        self.lobe.apply_to(s)?;
-        self.k_back.apply_to(s)?;
-        self.unproject.apply_to(s)?;
-        if let Some(t) = &self.turn {
-            t.apply_to(s)?;
-        }
-        self.t2.apply_to(s)?;
-        self.window.apply_to(s)
-    }
-
     pub fn chain(&self) -> Chain {
         let mut c = Chain::new();
         c.push(self.t1);
@@ -119,17 +94,5 @@ impl Ops {
         c.push(self.t2);
         c.push(self.window);
         c
-    }
-}
-
-/// One ray's operators, built once and shared by every state of `eval_batch_typed`,
-/// through their typed bodies: the fixed chain without a tape, as a Rust caller that
-/// knows its operators writes it.
-pub struct Shared(pub Ops);
-
-impl StateOps for Shared {
-    #[inline(always)]
-    fn apply<S: Spectrum>(&self, _: usize, s: &mut S) -> Result<(), CovError> {
-        self.0.try_typed(s)
     }
 }

@@ -210,7 +210,7 @@ impl Lobe {
     /// # Errors
     /// Overflow.
     #[inline(always)]
-    pub fn apply_to<S: Spectrum + ?Sized>(&self, cov: &mut S) -> Result<(), CovError> {
+    pub fn convolve<S: Spectrum + ?Sized>(&self, cov: &mut S) -> Result<(), CovError> {
         let (vu, vv) = self.variances();
         // Written out per axis (not a loop over `direction_axes`), so that a caller that
         // knows its spectrum type gets each lobe with a constant axis.
@@ -259,22 +259,9 @@ impl Brdf {
     }
 }
 
-impl Brdf {
-    /// [`Operator::apply`] with the spectrum's type known where it is called: on a
-    /// concrete `Cov<N>` or `CovFactor<N>` the kernels inline with constant indices (no
-    /// dynamic dispatch); `&mut dyn Spectrum` works too. The same result bits either way.
-    ///
-    /// # Errors
-    /// As [`Operator::apply`].
-    #[inline(always)]
-    pub fn apply_to<S: Spectrum + ?Sized>(&self, cov: &mut S) -> Result<(), CovError> {
-        self.lobe.apply_to(cov)
-    }
-}
-
 impl Operator for Brdf {
     fn apply(&self, cov: &mut dyn Spectrum) -> Result<(), CovError> {
-        self.apply_to(cov)
+        cov_core::typed!(cov, |cov| self.lobe.convolve(cov))
     }
 }
 
@@ -353,7 +340,7 @@ impl Operator for Reflect {
         Operator::apply(&Mirror, cov)?;
         self.curvature.apply_oblique(cov, self.project.cos(), 1.0)?;
         Operator::apply(&Mirror, cov)?;
-        self.lobe.apply_to(cov)?;
+        self.lobe.convolve(cov)?;
         if self.turn.angle() != 0.0 {
             cov.rotate_frame_by(self.turn)?;
         }

@@ -192,31 +192,3 @@ pub fn axis_index(n: usize, axis: Axis) -> Result<usize, CovError> {
         None => Err(CovError::MissingAxis { axis, layout: n }),
     }
 }
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn layouts_and_indices() {
-        assert_eq!(axis_index(2, Axis::U).unwrap(), 1);
-        assert_eq!(axis_index(3, Axis::T).unwrap(), 2);
-        assert_eq!(axis_index(4, Axis::V).unwrap(), 3);
-        assert_eq!(axis_index(5, Axis::T).unwrap(), 4);
-        assert!(axis_index(4, Axis::T).is_err());
-        assert!(axis_index(2, Axis::Y).is_err());
-    }
-
-    #[test]
-    fn smallest_layout() {
-        assert_eq!(AxisSet::FLAT.smallest_layout(), 2);
-        assert_eq!(AxisSet::FLAT_TIME.smallest_layout(), 3);
-        assert_eq!(AxisSet::SPACE.smallest_layout(), 4);
-        assert_eq!(AxisSet::ALL.smallest_layout(), 5);
-        assert_eq!(AxisSet::of(&[Axis::X, Axis::V]).smallest_layout(), 4);
-        for n in 2..=5 {
-            assert_eq!(layout_set(n).smallest_layout(), n);
-        }
-        assert_eq!(AxisSet::of(&[Axis::X, Axis::T]).to_string(), "{x,t}");
-    }
-}

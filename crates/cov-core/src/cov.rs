@@ -129,19 +129,6 @@ impl<const N: usize> Cov<N> {
         &self.p[..Self::PACKED_LEN]
     }
 
-    /// The whole packed storage (the first [`Cov::PACKED_LEN`] entries are Σ's), for
-    /// kernels that move many states at once.
-    #[inline(always)]
-    pub(crate) fn raw(&self) -> &[f64; PACKED] {
-        &self.p
-    }
-
-    /// [`Cov::raw`], writable: the caller keeps Σ symmetric PSD (a kernel's result).
-    #[inline(always)]
-    pub(crate) fn raw_mut(&mut self) -> &mut [f64; PACKED] {
-        &mut self.p
-    }
-
     /// Diagonal Σ from per-axis variances of the spectrum ((cycles/unit)²).
     ///
     /// # Errors
@@ -574,91 +561,5 @@ impl<'de, const N: usize> serde::Deserialize<'de> for Cov<N> {
         }
         let m = SMatrix::<f64, N, N>::from_fn(|i, j| rows[i][j]);
         Cov::from_matrix(&m).map_err(D::Error::custom)
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn packed_index_is_bijective() {
-        fn check<const N: usize>() {
-            let mut seen = vec![false; N * (N + 1) / 2];
-            for i in 0..N {
-                for j in i..N {
-                    let k = Cov::<N>::idx(i, j);
-                    assert!(!seen[k]);
-                    seen[k] = true;
-                    assert_eq!(k, Cov::<N>::idx(j, i));
-                }
-            }
-            assert!(seen.iter().all(|s| *s));
-        }
-        check::<2>();
-        check::<3>();
-        check::<4>();
-        check::<5>();
-    }
-
-    #[test]
-    fn gaussian_matches_fact() {
-        let c = Cov::<2>::gaussian([0.5, f64::INFINITY]).unwrap();
-        assert!((c.get(0, 0) - 1.0 / (FOUR_PI_SQ * 0.25)).abs() < 1e-15);
-        assert_eq!(c.get(1, 1), 0.0);
-        assert!(Cov::<2>::gaussian([0.0, 1.0]).is_err());
-        assert!(Cov::<2>::gaussian([f64::NAN, 1.0]).is_err());
-        assert!(Cov::<2>::gaussian([1e-200, 1.0]).is_err());
-        let p = SMatrix::<f64, 2, 2>::new(0.25, 0.0, 0.0, 4.0);
-        let c2 = Cov::<2>::from_primal_covariance(&p).unwrap();
-        let expected = Cov::<2>::gaussian([0.5, 2.0]).unwrap();
-        assert!(approx::relative_eq!(c2, expected, max_relative = 1e-14));
-    }
-
-    #[test]
-    fn dirac_is_relative_to_scene() {
-        let a = Cov::<4>::dirac(1.0, DIRAC_RELATIVE_SIZE).unwrap();
-        let b = Cov::<4>::dirac(1000.0, DIRAC_RELATIVE_SIZE).unwrap();
-        assert!((a.get(0, 0) / b.get(0, 0) - 1e6).abs() < 1e-6);
-        assert_eq!(a.get(2, 2), 0.0);
-        assert!(Cov::<4>::dirac(0.0, 1e-6).is_err());
-        assert!(Cov::<4>::dirac(f64::NAN, 1e-6).is_err());
-    }
-
-    #[test]
-    fn from_matrix_validates() {
-        let ok = SMatrix::<f64, 2, 2>::new(2.0, 1.0, 1.0, 2.0);
-        assert!(Cov::from_matrix(&ok).is_ok());
-        let asym = SMatrix::<f64, 2, 2>::new(2.0, 1.0, 0.5, 2.0);
-        assert!(matches!(
-            Cov::from_matrix(&asym),
-            Err(CovError::NotSymmetric { .. })
-        ));
-        let neg = SMatrix::<f64, 2, 2>::new(1.0, 2.0, 2.0, 1.0);
-        assert!(matches!(Cov::from_matrix(&neg), Err(CovError::NotPsd { .. })));
-        let nan = SMatrix::<f64, 2, 2>::new(1.0, f64::NAN, f64::NAN, 1.0);
-        assert!(matches!(Cov::from_matrix(&nan), Err(CovError::Overflow { .. })));
-    }
-
-    #[test]
-    fn serde_roundtrip_via_rows() {
-        let c = Cov::<3>::gaussian([0.1, 0.2, 0.3]).unwrap();
-        let m = c.to_matrix();
-        let back = Cov::<3>::from_matrix(&m).unwrap();
-        assert_eq!(c, back);
-    }
-
-    #[test]
-    fn validity_of_degenerate() {
-        let z = Cov::<5>::zeros().validity();
-        assert!(z.is_valid());
-        assert_eq!(z.condition, 1.0);
-        let mut c = Cov::<2>::zeros();
-        c.set(0, 0, 1e300);
-        let v = c.validity();
-        assert!(v.is_valid());
-        assert!(v.condition.is_infinite());
-        c.set(0, 0, f64::INFINITY);
-        assert!(!c.validity().is_valid());
     }
 }

@@ -67,33 +67,28 @@
 
 mod any;
 mod axis;
-mod batch;
 mod cov;
+mod direct;
 mod error;
 mod form;
-mod lanes;
 pub mod linalg;
 mod operator;
 mod query;
 mod report;
 pub mod spec;
 mod spectrum;
-mod tape;
 
 pub use any::{AnyCov, AnyFactor, AnySpectrum};
 pub use axis::{Axis, AxisSet, axis_index, layout_axes, layout_set};
-pub use batch::{CHUNK, LANES, StateOps, eval_batch_typed, eval_batch_with};
 pub use cov::{Cov, DIRAC_RELATIVE_SIZE, FOUR_PI_SQ, PSD_RTOL, Validity};
 pub use cov_derive::OperatorSpec;
 pub use error::{CovError, ECHO_MAX, echo, line_col, num, one_line, utf8_error_at};
 pub use form::{CovFactor, ROW_SNAP, SCHUR_SNAP};
-pub use lanes::CovLanes;
 pub use operator::{Chain, Operator, Step, Trace, check_layout};
 pub use query::{CovBlock, Filter, NYQUIST_K, primal_std_of_spectrum};
 pub use report::{Field, Report, ReportField};
 pub use spec::{Build, Checked, OperatorReader, OperatorSpec, Param, ParamValue, Registrar};
 pub use spectrum::{Concrete, Form, Spectrum, Turn, transverse_pairs};
-pub use tape::{Block, Kernel, Recorder, Tape};
 
 /// serde, for the code `#[derive(OperatorSpec)]` generates.
 #[doc(hidden)]

@@ -1,14 +1,11 @@
 //! The [`Operator`] trait and [`Chain`]s of operators (light paths).
 
 use std::fmt;
-use std::sync::atomic::{AtomicU32, Ordering};
-use std::sync::{Arc, OnceLock};
+use std::sync::Arc;
 
+use crate::direct::Direct;
 use crate::form::Kernels;
-use crate::tape::Direct;
-use crate::{
-    AnyCov, AnySpectrum, AxisSet, Concrete, Cov, CovError, Form, Report, Spectrum, Tape, layout_set,
-};
+use crate::{AnyCov, AnySpectrum, AxisSet, Concrete, Cov, CovError, Form, Report, Spectrum, layout_set};
 
 /// An event on a light path, acting on the spectrum covariance.
 ///
@@ -21,12 +18,12 @@ use crate::{
 /// `Arc<dyn Operator>`.
 ///
 /// **Typed bodies.** Through `dyn Spectrum` every kernel call is a dynamic call that
-/// resolves its axes at run time. An operator can write its body once as a generic
-/// method, `fn apply_to<S: Spectrum + ?Sized>(&self, s: &mut S)`, and implement
-/// `apply` as `self.apply_to(s)`: a caller that holds a concrete `Cov<N>` or
-/// `CovFactor<N>` then gets the kernels inlined with constant indices, with the same
-/// checks and the same bits. The bundled operators of the bounce chain (travel,
-/// curvature, projection, mirror, frame rotation, BRDF lobe, window) do this.
+/// resolves its axes at run time. An operator can write its body inside
+/// [`typed!`](crate::typed): `fn apply(&self, cov) { cov_core::typed!(cov, |cov| { … }) }`.
+/// The body, written once, is then compiled for each form and layout, and on a `Cov<N>`
+/// or `CovFactor<N>` its kernels inline with constant indices, with the same checks and
+/// the same bits as on `&mut dyn Spectrum`. The bundled operators of the bounce chain
+/// (travel, curvature, projection, mirror, frame rotation, BRDF lobe, window) do this.
 ///
 /// ```
 /// use cov_core::{Axis, Cov, CovError, CovFactor, Operator, Spectrum};
@@ -96,6 +93,57 @@ pub trait Operator: fmt::Debug + Send + Sync {
     }
 }
 
+/// Runs an operator's body with the spectrum's concrete type known: `typed!(cov, |s|
+/// body)` evaluates `body` with `s` bound to the `Cov<N>` or `CovFactor<N>` behind `cov`
+/// (a `&mut dyn Spectrum`), or to `cov` itself for any other spectrum. The body is
+/// written once and compiled for each form and layout, so its kernel calls inline with
+/// constant axis indices instead of going through the trait object; the results, bits
+/// and errors are those of the same body on `&mut dyn Spectrum`. `?` and `return` in the
+/// body leave the enclosing function, as in any block.
+///
+/// ```
+/// use cov_core::{Axis, Cov, CovError, Operator, Spectrum};
+///
+/// #[derive(Debug)]
+/// struct MyTravel(f64);
+///
+/// impl Operator for MyTravel {
+///     fn apply(&self, cov: &mut dyn Spectrum) -> Result<(), CovError> {
+///         cov_core::typed!(cov, |s| {
+///             for &(p, d) in s.transverse_pairs() {
+///                 s.shear(p, d, -self.0)?;
+///             }
+///             Ok(())
+///         })
+///     }
+/// }
+///
+/// let mut c = Cov::<4>::gaussian([0.1, 0.1, f64::INFINITY, f64::INFINITY])?;
+/// MyTravel(2.0).apply(&mut c)?;
+/// assert!(c.get(3, 3) > 0.0);
+/// # Ok::<(), CovError>(())
+/// ```
+#[macro_export]
+macro_rules! typed {
+    ($cov:expr, |$s:ident| $body:expr) => {{
+        let cov: &mut dyn $crate::Spectrum = $cov;
+        match cov.concrete() {
+            $crate::Concrete::Cov2($s) => $body,
+            $crate::Concrete::Cov3($s) => $body,
+            $crate::Concrete::Cov4($s) => $body,
+            $crate::Concrete::Cov5($s) => $body,
+            $crate::Concrete::Factor2($s) => $body,
+            $crate::Concrete::Factor3($s) => $body,
+            $crate::Concrete::Factor4($s) => $body,
+            $crate::Concrete::Factor5($s) => $body,
+            $crate::Concrete::Other => {
+                let $s = cov;
+                $body
+            }
+        }
+    }};
+}
+
 fn short_type_name(full: &'static str) -> &'static str {
     let base = full.split('<').next().unwrap_or(full);
     base.rsplit("::").next().unwrap_or(base)
@@ -123,17 +171,6 @@ fn short_type_name(full: &'static str) -> &'static str {
 #[derive(Clone, Debug, Default)]
 pub struct Chain {
     steps: Vec<Arc<dyn Operator>>,
-    /// Compiled tapes, one per (layout, form), built on the second evaluation in that
-    /// layout and form (a chain evaluated once, as a renderer's per-path chain is, is not
-    /// worth recording) or by the first [`Chain::eval_batch`]. Shared by clones; reset by
-    /// every change of the steps.
-    compiled: Arc<Compiled>,
-}
-
-#[derive(Debug, Default)]
-struct Compiled {
-    tapes: [OnceLock<Tape>; 8],
-    uses: [AtomicU32; 8],
 }
 
 /// One recorded step of a [`Chain::trace`].
@@ -185,73 +222,15 @@ impl Chain {
     /// Appends a shared operator.
     pub fn push_shared(&mut self, op: Arc<dyn Operator>) {
         self.steps.push(op);
-        self.compiled = Arc::default();
-    }
-
-    /// The chain compiled for layout `dim` and `form`: the kernel calls of every step
-    /// with axes resolved and parameters checked ([`Tape`]). Steps that read Σ stay
-    /// opaque. [`Chain::eval`] and the other evaluations compile on their own (from the
-    /// second evaluation in a layout and form on); this is for inspection and for
-    /// [`Tape::run_cov`].
-    ///
-    /// # Errors
-    /// [`CovError::Shape`] for a layout size outside 2..=5.
-    pub fn compile(&self, dim: usize, form: Form) -> Result<Tape, CovError> {
-        let mut tape = Tape::new(dim, form)?;
-        self.record_into(&mut tape);
-        Ok(tape)
-    }
-
-    fn record_into(&self, tape: &mut Tape) {
-        for op in &self.steps {
-            tape.push_shared(op);
-        }
-    }
-
-    /// The cached tape of layout `K::DIM` and form `K::FORM`, lowered for `K`. Without
-    /// `force`, only once the chain has been evaluated there before (`None` on a first
-    /// evaluation); a batch forces it.
-    pub(crate) fn tape<K: Kernels>(&self, force: bool) -> Option<&Tape> {
-        let slot = (K::DIM - 2) * 2 + usize::from(K::FORM == Form::SquareRoot);
-        let c = &self.compiled;
-        if let Some(t) = c.tapes[slot].get() {
-            return Some(t);
-        }
-        if !force && c.uses[slot].fetch_add(1, Ordering::Relaxed) == 0 {
-            return None;
-        }
-        Some(c.tapes[slot].get_or_init(|| {
-            let mut tape = Tape::empty(K::DIM, K::FORM);
-            self.record_into(&mut tape);
-            tape.prepare::<K>();
-            tape
-        }))
     }
 
     /// The fast path on a concrete form, on a copy of Σ committed if it ran clean: the
-    /// compiled tape, or on a first evaluation the operators applied to the unchecked
-    /// kernels ([`Direct`]). Otherwise the checked path, which finds and reports the
-    /// failing step and leaves Σ as it was.
+    /// operators on the unchecked kernels ([`Direct`]), with one finiteness check at the
+    /// end. Otherwise the checked path, which finds and reports the failing step and
+    /// leaves Σ as it was.
     fn apply_fast<K: Kernels>(&self, k: &mut K) -> Result<(), CovError> {
-        let tape = self.tape::<K>(false);
-        if let Some(tape) = tape
-            && K::FORM == Form::Covariance
-            && tape.program().is_some()
-        {
-            // The compiled covariance program works on its own copy and writes `k` only
-            // when it ran clean.
-            return if tape.run(k) {
-                Ok(())
-            } else {
-                self.apply_checked(k)
-            };
-        }
         let mut work = *k;
-        let clean = match tape {
-            Some(tape) => tape.run(&mut work),
-            None => self.apply_direct(&mut work),
-        };
-        if clean {
+        if self.apply_direct(&mut work) {
             *k = work;
             return Ok(());
         }
@@ -407,11 +386,11 @@ fn apply_step(index: usize, op: &dyn Operator, c: &mut dyn Spectrum) -> Result<(
 }
 
 impl Operator for Chain {
-    /// On `Cov<N>` and `CovFactor<N>` this runs the compiled tape ([`Chain::compile`]),
-    /// or on the chain's first evaluation in that layout and form its operators on the
-    /// unchecked kernels, and falls back to the checked steps only if that result is not
-    /// clean, so errors name the same step, operator and value as the checked path; Σ is
-    /// left as it was on error. Other spectra take the checked path.
+    /// On `Cov<N>` and `CovFactor<N>` this runs the operators on the unchecked kernels and
+    /// checks finiteness once, at the end; it falls back to the checked steps only if
+    /// that result is not clean, so errors name the same step, operator and value as the
+    /// checked path, and Σ is left as it was on error. Other spectra take the checked
+    /// path.
     fn apply(&self, cov: &mut dyn Spectrum) -> Result<(), CovError> {
         match cov.concrete() {
             Concrete::Cov2(c) => self.apply_fast(c),
@@ -422,10 +401,6 @@ impl Operator for Chain {
             Concrete::Factor3(f) => self.apply_fast(f),
             Concrete::Factor4(f) => self.apply_fast(f),
             Concrete::Factor5(f) => self.apply_fast(f),
-            Concrete::Tape(tape) => {
-                self.record_into(tape);
-                Ok(())
-            }
             Concrete::Other => self.apply_checked(cov),
         }
     }

@@ -80,7 +80,7 @@ pub trait Spectrum: fmt::Debug {
     fn first_non_finite(&self) -> Option<(usize, usize, f64)>;
 
     /// The concrete form behind this trait object, so that a [`crate::Chain`] can run its
-    /// compiled fast path ([`crate::Tape`]) on it. Default: [`Concrete::Other`], which
+    /// unchecked fast path on it. Default: [`Concrete::Other`], which
     /// takes the checked path (a third-party `Spectrum` needs nothing more).
     fn concrete(&mut self) -> Concrete<'_> {
         Concrete::Other
@@ -358,7 +358,7 @@ fn integrate_block<S: Spectrum + ?Sized>(spec: &mut S, axes: &[Axis]) -> Result<
 }
 
 /// What a `&mut dyn Spectrum` holds ([`Spectrum::concrete`]): one of the two forms in one
-/// of the four layouts, the tape of a recorder, or something else.
+/// of the four layouts, or something else.
 #[derive(Debug)]
 pub enum Concrete<'a> {
     /// `Cov<2>`.
@@ -377,9 +377,6 @@ pub enum Concrete<'a> {
     Factor4(&'a mut CovFactor<4>),
     /// `CovFactor<5>`.
     Factor5(&'a mut CovFactor<5>),
-    /// The tape of a [`crate::Recorder`]: a chain nested in a recorded chain records its steps
-    /// one by one ([`crate::Tape::push_shared`]).
-    Tape(&'a mut crate::Tape),
     /// Any other implementation.
     Other,
 }

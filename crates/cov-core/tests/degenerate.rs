@@ -197,19 +197,12 @@ fn integration_over_a_denormal_axis_beside_a_huge_one() {
         );
         check_clean(x, what);
     }
-    // The compiled chain and the batch lanes fall back to the checked kernel: the same.
+    // A chain's unchecked fast path falls back to the checked kernel: the same.
     let mut chain = Chain::new();
     chain.push(IntegrateU);
     for _ in 0..3 {
         let mut x = c;
         chain.apply(&mut x).expect("well posed");
-        assert!(x.is_finite() && x.get(0, 0).abs() <= 1e288, "{x:?}");
-    }
-    let mut many = vec![c; 70];
-    assert!(chain.eval_batch(cov_core::Form::Covariance, &mut many).is_empty());
-    let mut lanes: cov_core::CovLanes<2> = many.iter().copied().collect();
-    assert!(chain.eval_lanes(&mut lanes).is_empty());
-    for x in many.iter().chain(lanes.to_vec().iter()) {
         assert!(x.is_finite() && x.get(0, 0).abs() <= 1e288, "{x:?}");
     }
 }

@@ -168,24 +168,7 @@ impl Curvature {
 }
 
 impl Curvature {
-    /// [`Operator::apply`] with the spectrum's type known where it is called: on a
-    /// concrete `Cov<N>` or `CovFactor<N>` the kernels inline with constant indices (no
-    /// dynamic dispatch); `&mut dyn Spectrum` works too. The same result bits either way.
-    ///
-    /// # Errors
-    /// As [`Operator::apply`].
-    #[inline]
-    pub fn apply_to<S: Spectrum + ?Sized>(&self, cov: &mut S) -> Result<(), CovError> {
-        if self.is_isotropic() {
-            for &(p, d) in cov.transverse_pairs() {
-                cov.shear(d, p, self.kx)?;
-            }
-            return Ok(());
-        }
-        self.apply_principal(cov)
-    }
-
-    /// The anisotropic case of [`Curvature::apply_to`], out of line so that the common
+    /// The anisotropic case of [`Curvature`]'s body, out of line so that the common
     /// isotropic case stays small enough to inline.
     #[inline(never)]
     fn apply_principal<S: Spectrum + ?Sized>(&self, cov: &mut S) -> Result<(), CovError> {
@@ -199,7 +182,15 @@ impl Curvature {
 
 impl Operator for Curvature {
     fn apply(&self, cov: &mut dyn Spectrum) -> Result<(), CovError> {
-        self.apply_to(cov)
+        cov_core::typed!(cov, |cov| {
+            if self.is_isotropic() {
+                for &(p, d) in cov.transverse_pairs() {
+                    cov.shear(d, p, self.kx)?;
+                }
+                return Ok(());
+            }
+            self.apply_principal(cov)
+        })
     }
     fn requires(&self) -> AxisSet {
         if self.is_isotropic() {
@@ -229,35 +220,24 @@ impl CurvatureTensor {
     }
 }
 
-impl CurvatureTensor {
-    /// [`Operator::apply`] with the spectrum's type known where it is called: on a
-    /// concrete `Cov<N>` or `CovFactor<N>` the kernels inline with constant indices (no
-    /// dynamic dispatch); `&mut dyn Spectrum` works too. The same result bits either way.
-    ///
-    /// # Errors
-    /// As [`Operator::apply`].
-    #[inline]
-    pub fn apply_to<S: Spectrum + ?Sized>(&self, cov: &mut S) -> Result<(), CovError> {
-        let [kxx, kxy, kyy] = self.k;
-        cov.shear(Axis::U, Axis::X, kxx)?;
-        if cov.has(Axis::Y) {
-            // The four shears commute: each adds position to direction.
-            cov.shear(Axis::U, Axis::Y, kxy)?;
-            cov.shear(Axis::V, Axis::X, kxy)?;
-            cov.shear(Axis::V, Axis::Y, kyy)?;
-        } else if kxy != 0.0 || kyy != 0.0 {
-            return Err(CovError::MissingAxis {
-                axis: Axis::Y,
-                layout: cov.dim(),
-            });
-        }
-        Ok(())
-    }
-}
-
 impl Operator for CurvatureTensor {
     fn apply(&self, cov: &mut dyn Spectrum) -> Result<(), CovError> {
-        self.apply_to(cov)
+        cov_core::typed!(cov, |cov| {
+            let [kxx, kxy, kyy] = self.k;
+            cov.shear(Axis::U, Axis::X, kxx)?;
+            if cov.has(Axis::Y) {
+                // The four shears commute: each adds position to direction.
+                cov.shear(Axis::U, Axis::Y, kxy)?;
+                cov.shear(Axis::V, Axis::X, kxy)?;
+                cov.shear(Axis::V, Axis::Y, kyy)?;
+            } else if kxy != 0.0 || kyy != 0.0 {
+                return Err(CovError::MissingAxis {
+                    axis: Axis::Y,
+                    layout: cov.dim(),
+                });
+            }
+            Ok(())
+        })
     }
     fn requires(&self) -> AxisSet {
         if self.k[1] != 0.0 || self.k[2] != 0.0 {

@@ -115,26 +115,15 @@ impl Window {
     }
 }
 
-impl Window {
-    /// [`Operator::apply`] with the spectrum's type known where it is called: on a
-    /// concrete `Cov<N>` or `CovFactor<N>` the kernels inline with constant indices (no
-    /// dynamic dispatch); `&mut dyn Spectrum` works too. The same result bits either way.
-    ///
-    /// # Errors
-    /// As [`Operator::apply`].
-    #[inline]
-    pub fn apply_to<S: Spectrum + ?Sized>(&self, cov: &mut S) -> Result<(), CovError> {
-        cov.add_variance(Axis::X, self.wx)?;
-        if cov.has(Axis::Y) {
-            cov.add_variance(Axis::Y, self.wy)?;
-        }
-        Ok(())
-    }
-}
-
 impl Operator for Window {
     fn apply(&self, cov: &mut dyn Spectrum) -> Result<(), CovError> {
-        self.apply_to(cov)
+        cov_core::typed!(cov, |cov| {
+            cov.add_variance(Axis::X, self.wx)?;
+            if cov.has(Axis::Y) {
+                cov.add_variance(Axis::Y, self.wy)?;
+            }
+            Ok(())
+        })
     }
 }
 

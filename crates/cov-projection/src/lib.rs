@@ -171,23 +171,12 @@ impl Project {
     }
 }
 
-impl Project {
-    /// [`Operator::apply`] with the spectrum's type known where it is called: on a
-    /// concrete `Cov<N>` or `CovFactor<N>` the kernels inline with constant indices (no
-    /// dynamic dispatch); `&mut dyn Spectrum` works too. The same result bits either way.
-    ///
-    /// # Errors
-    /// As [`Operator::apply`].
-    #[inline(always)]
-    pub fn apply_to<S: Spectrum + ?Sized>(&self, cov: &mut S) -> Result<(), CovError> {
-        rotate(cov, self.turn)?;
-        cov.scale(Axis::X, self.cos)
-    }
-}
-
 impl Operator for Project {
     fn apply(&self, cov: &mut dyn Spectrum) -> Result<(), CovError> {
-        self.apply_to(cov)
+        cov_core::typed!(cov, |cov| {
+            rotate(cov, self.turn)?;
+            cov.scale(Axis::X, self.cos)
+        })
     }
     fn requires(&self) -> AxisSet {
         needs(self.turn.angle())
@@ -231,23 +220,12 @@ impl Unproject {
     }
 }
 
-impl Unproject {
-    /// [`Operator::apply`] with the spectrum's type known where it is called: on a
-    /// concrete `Cov<N>` or `CovFactor<N>` the kernels inline with constant indices (no
-    /// dynamic dispatch); `&mut dyn Spectrum` works too. The same result bits either way.
-    ///
-    /// # Errors
-    /// As [`Operator::apply`].
-    #[inline(always)]
-    pub fn apply_to<S: Spectrum + ?Sized>(&self, cov: &mut S) -> Result<(), CovError> {
-        cov.scale(Axis::X, 1.0 / self.cos)?;
-        rotate(cov, self.turn)
-    }
-}
-
 impl Operator for Unproject {
     fn apply(&self, cov: &mut dyn Spectrum) -> Result<(), CovError> {
-        self.apply_to(cov)
+        cov_core::typed!(cov, |cov| {
+            cov.scale(Axis::X, 1.0 / self.cos)?;
+            rotate(cov, self.turn)
+        })
     }
     fn requires(&self) -> AxisSet {
         needs(self.turn.angle())
@@ -263,27 +241,16 @@ impl Mirror {
     pub const NAME: &'static str = "Mirror";
 }
 
-impl Mirror {
-    /// [`Operator::apply`] with the spectrum's type known where it is called: on a
-    /// concrete `Cov<N>` or `CovFactor<N>` the kernels inline with constant indices (no
-    /// dynamic dispatch); `&mut dyn Spectrum` works too. The same result bits either way.
-    ///
-    /// # Errors
-    /// As [`Operator::apply`].
-    #[inline]
-    pub fn apply_to<S: Spectrum + ?Sized>(&self, cov: &mut S) -> Result<(), CovError> {
-        // Per axis, not a loop over `direction_axes`: constant axes for a known type.
-        cov.scale(Axis::U, -1.0)?;
-        if cov.has(Axis::V) {
-            cov.scale(Axis::V, -1.0)?;
-        }
-        Ok(())
-    }
-}
-
 impl Operator for Mirror {
     fn apply(&self, cov: &mut dyn Spectrum) -> Result<(), CovError> {
-        self.apply_to(cov)
+        cov_core::typed!(cov, |cov| {
+            // Per axis, not a loop over `direction_axes`: constant axes for a known type.
+            cov.scale(Axis::U, -1.0)?;
+            if cov.has(Axis::V) {
+                cov.scale(Axis::V, -1.0)?;
+            }
+            Ok(())
+        })
     }
 }
 
@@ -305,22 +272,9 @@ impl RotateFrame {
     }
 }
 
-impl RotateFrame {
-    /// [`Operator::apply`] with the spectrum's type known where it is called: on a
-    /// concrete `Cov<N>` or `CovFactor<N>` the kernels inline with constant indices (no
-    /// dynamic dispatch); `&mut dyn Spectrum` works too. The same result bits either way.
-    ///
-    /// # Errors
-    /// As [`Operator::apply`].
-    #[inline]
-    pub fn apply_to<S: Spectrum + ?Sized>(&self, cov: &mut S) -> Result<(), CovError> {
-        cov.rotate_frame_by(self.turn)
-    }
-}
-
 impl Operator for RotateFrame {
     fn apply(&self, cov: &mut dyn Spectrum) -> Result<(), CovError> {
-        self.apply_to(cov)
+        cov_core::typed!(cov, |cov| cov.rotate_frame_by(self.turn))
     }
     fn requires(&self) -> AxisSet {
         AxisSet::SPACE

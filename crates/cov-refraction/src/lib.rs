@@ -155,6 +155,6 @@ impl RoughRefract {
 impl Operator for RoughRefract {
     fn apply(&self, cov: &mut dyn Spectrum) -> Result<(), CovError> {
         Operator::apply(&self.refract, cov)?;
-        self.lobe.apply_to(cov)
+        self.lobe.convolve(cov)
     }
 }

@@ -71,36 +71,13 @@ impl Travel {
     }
 }
 
-impl Travel {
-    /// [`Operator::apply`] with the spectrum's type known where it is called: on a
-    /// concrete `Cov<N>` or `CovFactor<N>` the kernels inline with constant indices (no
-    /// dynamic dispatch); `&mut dyn Spectrum` works too. The same result bits either way.
-    ///
-    /// ```
-    /// use cov_core::{Cov, Operator};
-    /// use cov_travel::Travel;
-    ///
-    /// let start = Cov::<4>::gaussian([0.01, 0.01, 1.0, 1.0])?;
-    /// let (mut typed, mut dynamic) = (start, start);
-    /// Travel::new(2.0)?.apply_to(&mut typed)?; // static dispatch, constant indices
-    /// Travel::new(2.0)?.apply(&mut dynamic)?; // through `&mut dyn Spectrum`
-    /// assert_eq!(typed, dynamic);
-    /// # Ok::<(), cov_core::CovError>(())
-    /// ```
-    ///
-    /// # Errors
-    /// As [`Operator::apply`].
-    #[inline]
-    pub fn apply_to<S: Spectrum + ?Sized>(&self, cov: &mut S) -> Result<(), CovError> {
-        for &(p, d) in cov.transverse_pairs() {
-            cov.shear(p, d, -self.distance)?;
-        }
-        Ok(())
-    }
-}
-
 impl Operator for Travel {
     fn apply(&self, cov: &mut dyn Spectrum) -> Result<(), CovError> {
-        self.apply_to(cov)
+        cov_core::typed!(cov, |cov| {
+            for &(p, d) in cov.transverse_pairs() {
+                cov.shear(p, d, -self.distance)?;
+            }
+            Ok(())
+        })
     }
 }

@@ -1,13 +1,14 @@
-//! The 10-operator bounce chain of `benches/chain.rs` on 4,096 states (`mode` picks what
-//! runs; each `*-none` mode is the same loop without the chain). At N = 4 with fixed
-//! parameters: the baseline, `Chain::apply` in both forms, and `eval_batch_typed` with
-//! the operators built once and shared (`fixed-typed`). With per-state parameters
-//! (each state's operators built for it) at N = 2, 4, 5: `eval_batch_with` (a closure
-//! over `dyn Spectrum`) and `eval_batch_typed` (`StateOps`, the operators' typed bodies),
-//! covariance form. Run under `valgrind --tool=callgrind` by `count.sh` (one rayon
-//! thread), which subtracts the loop and divides by the states.
+//! The 10-operator bounce chain of `benches/chain.rs` on 4,096 states at N = 2, 4, 5
+//! (`mode-N` picks what runs; each `*-none` mode is the same loop without the chain).
+//! Per-ray parameters (each state's operators built for it, as a renderer does): the
+//! closed-form baseline (`base`), the operators applied one by one through
+//! `Operator::apply` (`apply`, covariance form; `apply-sqrt`, square-root form) and
+//! pushed on a `Chain` built per ray (`chain`, `chain-sqrt`). Fixed parameters at N = 4:
+//! the baseline (`fixed-base`) and one `Chain` applied to every state (`fixed-chain`).
+//! Run under `valgrind --tool=callgrind` by `count.sh`, which subtracts the loop and
+//! divides by the states.
 
-use covtrace::{Cov, CovError, CovFactor, Form, Operator, Spectrum, StateOps};
+use covtrace::{Cov, CovFactor, Operator};
 use glam::DVec3;
 use std::hint::black_box;
 
@@ -19,7 +20,7 @@ mod baseline;
 mod ops;
 
 use baseline::Ray;
-use ops::{Ops, Shared};
+use ops::Ops;
 
 const STATES: usize = 4096;
 
@@ -39,15 +40,6 @@ fn ray(i: usize) -> Ray {
         turn: 0.9,
         d2: 2.1 * d,
         std: 0.2,
-    }
-}
-
-/// Per-state operators for `eval_batch_typed`.
-struct PerState(usize);
-
-impl StateOps for PerState {
-    fn apply<S: Spectrum>(&self, i: usize, s: &mut S) -> Result<(), CovError> {
-        Ops::new(&ray(i), self.0).try_typed(s)
     }
 }
 
@@ -72,108 +64,86 @@ fn covs<const N: usize>() -> Vec<Cov<N>> {
         .collect()
 }
 
-/// `eval_batch_with` (`typed` false) or `eval_batch_typed` over 4,096 states of layout `N`.
-fn per_state<const N: usize>(run: bool, typed: bool) {
-    let mut s = covs::<N>();
-    let batch = |s: &mut [Cov<N>]| {
-        if typed {
-            covtrace::eval_batch_typed(Form::Covariance, s, &PerState(N))
-        } else {
-            covtrace::eval_batch_with(Form::Covariance, s, |i, c| Ops::new(&ray(i), N).try_dyn(c))
-        }
-    };
-    // Extra repetitions (CHAIN_PROBE_REPS) run on the evolving states; a failure would
-    // time the checked re-run instead of the fast path, so it is reported.
-    let reps = reps();
-    let failed: usize = (1..reps).map(|_| batch(&mut s).len()).sum();
-    if failed > 0 {
-        eprintln!("{failed} states failed over {reps} repetitions");
-    }
-    if run {
-        assert!(batch(&mut s).is_empty());
-    }
-    black_box(&s);
+fn packed<const N: usize>(c: &Cov<N>) -> baseline::Packed<N> {
+    let mut p = [0.0; 15];
+    p[..c.packed().len()].copy_from_slice(c.packed());
+    baseline::Packed { p }
 }
 
-/// `Chain::apply` over the states in place, after two evaluations that compile it.
-fn chain_over<S: Spectrum + Copy>(start: &[S], run: bool) {
-    let chain = Ops::new(&ray(0), 4).chain();
+/// Runs `f` on every state of a fresh copy of `start`, `reps()` times.
+fn over<S: Clone>(start: &[S], run: bool, mut f: impl FnMut(usize, &mut S)) {
     let mut s = start.to_vec();
-    chain.apply(&mut s[0]).expect("finite");
-    s.copy_from_slice(start);
-    chain.apply(&mut s[0]).expect("finite");
-    s.copy_from_slice(start);
-    if run {
-        for c in s.iter_mut() {
-            black_box(chain.apply(c).is_ok());
+    for _ in 0..reps() {
+        s.clone_from_slice(start);
+        if run {
+            for (i, c) in s.iter_mut().enumerate() {
+                f(i, c);
+            }
         }
+        black_box(&s);
     }
-    black_box(&s);
+}
+
+/// Per-ray `what` at layout `N`.
+fn per_ray<const N: usize>(what: &str, run: bool) {
+    let covs = covs::<N>();
+    let facs: Vec<CovFactor<N>> = covs.iter().map(CovFactor::from_cov).collect();
+    match what {
+        "base" => over(&covs.iter().map(packed).collect::<Vec<_>>(), run, |i, p| {
+            baseline::bounce(black_box(p), &black_box(ray(i)))
+        }),
+        "apply" => over(&covs, run, |i, c| {
+            black_box(Ops::new(&black_box(ray(i)), N).apply(c));
+        }),
+        "ray" => over(&covs, run, |i, _| {
+            black_box(ray(i));
+        }),
+        "build" => over(&covs, run, |i, _| {
+            black_box(Ops::new(&black_box(ray(i)), N));
+        }),
+        "apply-sqrt" => over(&facs, run, |i, c| {
+            black_box(Ops::new(&black_box(ray(i)), N).apply(c));
+        }),
+        "chain" => over(&covs, run, |i, c| {
+            black_box(Ops::new(&black_box(ray(i)), N).chain().apply(c).is_ok());
+        }),
+        "chain-sqrt" => over(&facs, run, |i, c| {
+            black_box(Ops::new(&black_box(ray(i)), N).chain().apply(c).is_ok());
+        }),
+        "fixed-base" => {
+            let fixed = baseline::Fixed::new(&black_box(ray(0)));
+            over(&covs.iter().map(packed).collect::<Vec<_>>(), run, |_, p| {
+                fixed.run(black_box(p))
+            })
+        }
+        "fixed-chain" => {
+            let chain = Ops::new(&black_box(ray(0)), N).chain();
+            over(&covs, run, |_, c| {
+                black_box(chain.apply(c).is_ok());
+            })
+        }
+        _ => usage(),
+    }
+}
+
+fn usage() {
+    eprintln!(
+        "usage: chain-probe MODE-N[-none], MODE one of base, apply, apply-sqrt, chain, chain-sqrt, fixed-base, fixed-chain; N one of 2, 4, 5"
+    );
+    std::process::exit(2);
 }
 
 fn main() {
     let mode = std::env::args().nth(1).unwrap_or_default();
     let run = !mode.ends_with("-none");
-    match mode.as_str() {
-        "cov" | "cov-none" => chain_over(&covs::<4>(), run),
-        "sqrt" | "sqrt-none" => {
-            let start: Vec<CovFactor<4>> = covs::<4>().iter().map(CovFactor::from_cov).collect();
-            chain_over(&start, run);
-        }
-        "fixed-typed" | "fixed-typed-none" => {
-            let ops = Shared(Ops::new(&ray(0), 4));
-            let mut s = covs::<4>();
-            if run {
-                assert!(covtrace::eval_batch_typed(Form::Covariance, &mut s, &ops).is_empty());
-            }
-            black_box(&s);
-        }
-        "ray-typed" | "ray-typed-none" | "ray-dyn" | "ray-dyn-none" => {
-            let typed = mode.starts_with("ray-typed");
-            let mut s = covs::<4>();
-            let start = s.clone();
-            for _ in 0..reps() {
-                s.copy_from_slice(&start);
-                if run {
-                    for (i, c) in s.iter_mut().enumerate() {
-                        let ops = Ops::new(&ray(i), 4);
-                        black_box(if typed { ops.apply_typed(c) } else { ops.apply(c) });
-                    }
-                }
-                black_box(&s);
-            }
-            black_box(&s);
-        }
-        "base" | "base-none" => {
-            let fixed = baseline::Fixed::new(&ray(0));
-            let mut s: Vec<baseline::Packed<4>> = covs::<4>()
-                .iter()
-                .map(|c| {
-                    let mut p = [0.0; 15];
-                    p[..10].copy_from_slice(c.packed());
-                    baseline::Packed { p }
-                })
-                .collect();
-            if run {
-                for p in s.iter_mut() {
-                    fixed.run(black_box(p));
-                }
-            }
-            black_box(&s);
-        }
-        m if m.starts_with("with-") || m.starts_with("typed-") => {
-            let typed = m.starts_with("typed");
-            match m.chars().find_map(|c| c.to_digit(10)) {
-                Some(2) => per_state::<2>(run, typed),
-                Some(5) => per_state::<5>(run, typed),
-                _ => per_state::<4>(run, typed),
-            }
-        }
-        _ => {
-            eprintln!(
-                "usage: chain-probe base|cov|sqrt|fixed-typed|with-2|typed-2|with-4|typed-4|with-5|typed-5 (or its -none loop)"
-            );
-            std::process::exit(2);
-        }
+    let mode = mode.trim_end_matches("-none");
+    let Some((what, n)) = mode.rsplit_once('-') else {
+        return usage();
+    };
+    match n {
+        "2" => per_ray::<2>(what, run),
+        "4" => per_ray::<4>(what, run),
+        "5" => per_ray::<5>(what, run),
+        _ => usage(),
     }
 }

@@ -58,85 +58,10 @@ impl<const N: usize> Spectrum for Cov<N> {
         super::overflow_at(self.check_finite(""))
     }
     fn concrete(&mut self) -> crate::Concrete<'_> {
-        crate::tape::concrete_cov(self)
+        crate::direct::concrete_cov(self)
     }
 
-    fn raw_congruence(&mut self, op: &str, a: &Small) -> Result<(), CovError> {
-        let old = *self;
-        self.congruence_in_place(a);
-        self.finish(op, old)
-    }
-
-    #[inline(always)]
-    fn raw_shear(&mut self, op: &str, i: usize, j: usize, s: f64) -> Result<(), CovError> {
-        // Compute the new column j, check it, then commit: Σ is untouched on overflow.
-        let col = self.shear_col(i, j, s);
-        self.commit_column(op, j, &col)
-    }
-
-    #[inline(always)]
-    fn raw_scale(&mut self, op: &str, i: usize, c: f64) -> Result<(), CovError> {
-        // The new row/column i, checked before it is written: Σ is untouched on overflow.
-        let col = self.scale_col(i, c);
-        self.commit_column(op, i, &col)
-    }
-
-    #[inline(always)]
-    fn raw_rotate(&mut self, op: &str, planes: &[(usize, usize)], c: f64, s: f64) -> Result<(), CovError> {
-        let old = *self;
-        // One or two planes written out, so that constant indices reach `rotate_idx`.
-        match *planes {
-            [(i, j)] => self.rotate_idx(i, j, c, s),
-            [(i, j), (k, l)] => {
-                self.rotate_idx(i, j, c, s);
-                self.rotate_idx(k, l, c, s);
-            }
-            _ => {
-                for &(i, j) in planes {
-                    self.rotate_idx(i, j, c, s);
-                }
-            }
-        }
-        self.finish(op, old)
-    }
-
-    #[inline]
-    fn raw_add_window(&mut self, op: &str, p: &[usize], w: &Small) -> Result<(), CovError> {
-        let old = *self;
-        self.add_window_in_place(p, w);
-        self.finish(op, old)
-    }
-
-    #[inline(always)]
-    fn raw_add_variance(&mut self, op: &str, i: usize, w: f64) -> Result<(), CovError> {
-        let v = self.get(i, i) + w;
-        if !v.is_finite() {
-            return Err(CovError::Overflow {
-                operator: op.into(),
-                row: i,
-                col: i,
-                value: v,
-            });
-        }
-        self.set(i, i, v);
-        Ok(())
-    }
-
-    #[inline(always)]
-    fn raw_lobe_1(&mut self, op: &str, p: usize, s: f64) -> Result<(), CovError> {
-        // Checked for every `s`, integration too: a Schur complement of a PSD Σ shrinks
-        // it, but its rounding near f64's range is not bounded by that.
-        let old = *self;
-        self.lobe_product_1(p, s);
-        self.finish(op, old)
-    }
-
-    #[inline]
-    fn raw_lobe(&mut self, op: &str, p: &[usize], s: &Small) -> Result<(), CovError> {
-        let old = *self;
-        self.lobe_in_place(p, s);
-        self.finish(op, old)
-    }
+    super::checked_kernels!();
 }
 
 impl<const N: usize> Kernels for Cov<N> {
@@ -429,43 +354,12 @@ impl<const N: usize> Cov<N> {
             let noise = v < 0.0 || before[a] <= 0.0 || (!p.contains(&a) && v <= SCHUR_SNAP * before[a]);
             if noise {
                 // `v − v`: +0 for a finite entry, NaN for ∞ or NaN, so a snap never
-                // hides an overflow (a compiled chain checks only at the end).
+                // hides an overflow (a chain's fast path checks only at the end).
                 for b in 0..N {
                     let v = self.get(a, b);
                     self.set(a, b, v - v);
                 }
             }
         }
-    }
-
-    /// Writes row and column `j` from `col` if every entry is finite; otherwise Σ is left
-    /// untouched and the first overflowing entry is reported.
-    #[inline(always)]
-    fn commit_column(&mut self, op: &str, j: usize, col: &[f64; N]) -> Result<(), CovError> {
-        super::require_finite_line(op, col, |k| (k.min(j), k.max(j)))?;
-        for (k, v) in col.iter().enumerate() {
-            self.set(k, j, *v);
-        }
-        Ok(())
-    }
-
-    /// Checks the result of a kernel; on overflow restores the input and reports.
-    #[inline(always)]
-    fn finish(&mut self, op: &str, old: Self) -> Result<(), CovError> {
-        // The branch-free test first (it vectorises); the search for the entry to report
-        // only on failure.
-        if self.all_finite() {
-            return Ok(());
-        }
-        self.overflowed(op, old)
-    }
-
-    /// The error of [`Cov::finish`], with Σ restored to `old`.
-    #[cold]
-    #[inline(never)]
-    fn overflowed(&mut self, op: &str, old: Self) -> Result<(), CovError> {
-        let e = self.check_finite(op);
-        *self = old;
-        e
     }
 }

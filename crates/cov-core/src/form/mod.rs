@@ -6,7 +6,6 @@ pub(crate) mod cov;
 mod factor;
 
 pub use cov::SCHUR_SNAP;
-pub(crate) use factor::psd_factor;
 pub use factor::{CovFactor, ROW_SNAP};
 
 /// Where a form's finiteness check failed, as (row, column, value).
@@ -17,41 +16,20 @@ pub(crate) fn overflow_at(check: Result<(), crate::CovError>) -> Option<(usize, 
     })
 }
 
-/// Checks a new row or column before a kernel writes it: the first non-finite entry is
-/// an overflow of `op`, at the (row, column) `at(k)` gives for position `k`.
-#[inline(always)]
-pub(crate) fn require_finite_line(
-    op: &str,
-    line: &[f64],
-    at: impl Fn(usize) -> (usize, usize),
-) -> Result<(), crate::CovError> {
-    match line.iter().position(|v| !v.is_finite()) {
-        None => Ok(()),
-        Some(k) => {
-            let (row, col) = at(k);
-            Err(crate::CovError::Overflow {
-                operator: op.into(),
-                row,
-                col,
-                value: line[k],
-            })
-        }
-    }
-}
-
-/// The unchecked in-place kernels of a concrete form, for compiled chains
-/// ([`crate::Tape`]). Indices are resolved and parameters checked when the tape is
-/// recorded; these kernels do not check their output: ∞ and NaN propagate, and the tape
-/// checks finiteness where a later kernel could hide them and at the end. Each computes
-/// exactly what the matching checked `raw_*` kernel of [`crate::Spectrum`] computes, so a
-/// compiled chain and a checked one give the same bits.
+/// The unchecked in-place kernels of a concrete form, for the fast path of a
+/// [`crate::Chain`] (`Direct`). Indices arrive resolved and parameters checked; these
+/// kernels do not check their output: ∞ and NaN propagate, and the chain checks
+/// finiteness where a later kernel could hide them and at the end. Each runs the same
+/// arithmetic as the matching checked `raw_*` kernel of [`crate::Spectrum`] (the two
+/// share the form's update functions), so the fast and the checked path give the same
+/// bits.
 pub(crate) trait Kernels: crate::Spectrum + Copy + Send + Sync + 'static {
     /// The form.
     const FORM: crate::Form;
     /// The layout size.
     const DIM: usize;
     /// Whether [`Kernels::k_lobe_1`] leaves some entry non-finite whenever its input
-    /// held one (its snap cannot hide an ∞), so that a compiled chain need not check
+    /// held one (its snap cannot hide an ∞), so that a chain's fast path need not check
     /// finiteness before it: the check at the end sees the overflow.
     const LOBE_1_KEEPS_NON_FINITE: bool;
     fn k_shear(&mut self, i: usize, j: usize, s: f64);
@@ -60,21 +38,112 @@ pub(crate) trait Kernels: crate::Spectrum + Copy + Send + Sync + 'static {
     fn k_add_variance(&mut self, i: usize, w: f64);
     fn k_lobe_1(&mut self, p: usize, s: f64);
     fn k_add_window(&mut self, p: &[usize], w: &crate::linalg::Small);
-    /// [`Kernels::k_add_window`] given a factor `F` of the window (`W = F Fᵀ`, `k × k`),
-    /// as a compiled chain holds it: the square-root form appends `F`'s columns without
-    /// factoring `W` again.
-    fn k_add_window_factor(&mut self, p: &[usize], f: &crate::linalg::Small) {
-        let k = p.len();
-        let mut w = [[0.0; crate::linalg::MAX]; crate::linalg::MAX];
-        for a in 0..k {
-            for b in 0..k {
-                w[a][b] = (0..k).map(|c| f[a][c] * f[b][c]).sum();
-            }
-        }
-        self.k_add_window(p, &w);
-    }
     fn k_lobe(&mut self, p: &[usize], s: &crate::linalg::Small);
     fn k_congruence(&mut self, a: &crate::linalg::Small);
     /// Whether every stored number is finite.
     fn all_finite(&self) -> bool;
+
+    /// The end of a checked kernel: `Ok` if every stored number is finite; otherwise Σ is
+    /// restored to `old` and the first non-finite entry is reported as an overflow of `op`.
+    #[inline(always)]
+    fn checked(&mut self, op: &str, old: Self) -> Result<(), crate::CovError> {
+        // The branch-free test first (it vectorises); the search for the entry to report
+        // only on failure.
+        if self.all_finite() {
+            return Ok(());
+        }
+        overflowed(self, op, old)
+    }
 }
+
+/// The error of [`Kernels::checked`], with Σ restored to `old`.
+#[cold]
+#[inline(never)]
+fn overflowed<K: Kernels>(k: &mut K, op: &str, old: K) -> Result<(), crate::CovError> {
+    let (row, col, value) = k.first_non_finite().unwrap_or((0, 0, f64::NAN));
+    *k = old;
+    Err(crate::CovError::Overflow {
+        operator: op.into(),
+        row,
+        col,
+        value,
+    })
+}
+
+/// The checked raw kernels of [`crate::Spectrum`] for a form, each derived from the
+/// form's unchecked kernel ([`Kernels`]): the kernel runs in place, then
+/// [`Kernels::checked`] restores Σ and reports if the result overflowed. So each rule's
+/// arithmetic is written once per form, and the checked and unchecked paths give the same
+/// bits.
+macro_rules! checked_kernels {
+    () => {
+        fn raw_congruence(&mut self, op: &str, a: &Small) -> Result<(), CovError> {
+            let old = *self;
+            self.k_congruence(a);
+            self.checked(op, old)
+        }
+        #[inline(always)]
+        fn raw_shear(&mut self, op: &str, i: usize, j: usize, s: f64) -> Result<(), CovError> {
+            let old = *self;
+            self.k_shear(i, j, s);
+            self.checked(op, old)
+        }
+        #[inline(always)]
+        fn raw_scale(&mut self, op: &str, i: usize, c: f64) -> Result<(), CovError> {
+            let old = *self;
+            self.k_scale(i, c);
+            self.checked(op, old)
+        }
+        #[inline(always)]
+        fn raw_rotate(
+            &mut self,
+            op: &str,
+            planes: &[(usize, usize)],
+            c: f64,
+            s: f64,
+        ) -> Result<(), CovError> {
+            let old = *self;
+            // One or two planes written out, so that constant indices reach the kernel.
+            match *planes {
+                [(i, j)] => self.k_rotate(i, j, c, s),
+                [(i, j), (k, l)] => {
+                    self.k_rotate(i, j, c, s);
+                    self.k_rotate(k, l, c, s);
+                }
+                _ => {
+                    for &(i, j) in planes {
+                        self.k_rotate(i, j, c, s);
+                    }
+                }
+            }
+            self.checked(op, old)
+        }
+        #[inline]
+        fn raw_add_window(&mut self, op: &str, p: &[usize], w: &Small) -> Result<(), CovError> {
+            let old = *self;
+            self.k_add_window(p, w);
+            self.checked(op, old)
+        }
+        #[inline(always)]
+        fn raw_add_variance(&mut self, op: &str, i: usize, w: f64) -> Result<(), CovError> {
+            let old = *self;
+            self.k_add_variance(i, w);
+            self.checked(op, old)
+        }
+        #[inline(always)]
+        fn raw_lobe_1(&mut self, op: &str, p: usize, s: f64) -> Result<(), CovError> {
+            // Checked for every `s`, integration too: a Schur complement of a PSD Σ
+            // shrinks it, but its rounding near f64's range is not bounded by that.
+            let old = *self;
+            self.k_lobe_1(p, s);
+            self.checked(op, old)
+        }
+        #[inline]
+        fn raw_lobe(&mut self, op: &str, p: &[usize], s: &Small) -> Result<(), CovError> {
+            let old = *self;
+            self.k_lobe(p, s);
+            self.checked(op, old)
+        }
+    };
+}
+pub(crate) use checked_kernels;
