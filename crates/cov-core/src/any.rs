@@ -317,31 +317,6 @@ impl<const N: usize> From<CovFactor<N>> for AnyFactor {
     }
 }
 
-impl AnyFactor {
-    /// A factor of `c` ([`CovFactor::from_cov`]).
-    pub fn from_cov(c: &AnyCov) -> AnyFactor {
-        each!(AnyCov, c, c => AnyFactor::from(CovFactor::from_cov(c)))
-    }
-
-    /// The typed factor when the layout is `N`.
-    pub fn to<const N: usize>(&self) -> Option<CovFactor<N>> {
-        each!(AnyFactor, self, f => f.cast::<N>())
-    }
-
-    /// Σ = L Lᵀ.
-    ///
-    /// # Errors
-    /// As [`CovFactor::to_cov`].
-    pub fn to_cov(&self) -> Result<AnyCov, CovError> {
-        each!(AnyFactor, self, f => f.to_cov().map(AnyCov::from))
-    }
-
-    /// This factor as a [`Spectrum`] in square-root form.
-    pub fn as_spectrum_mut(&mut self) -> &mut dyn Spectrum {
-        each!(AnyFactor, self, f => f as &mut dyn Spectrum)
-    }
-}
-
 /// Σ held in either form, in a layout chosen at run time: what [`crate::Chain`]
 /// evaluates a path in, and what [`Spectrum::snapshot`] saves.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -369,7 +344,9 @@ impl AnySpectrum {
     pub fn new(form: Form, c: &AnyCov) -> AnySpectrum {
         match form {
             Form::Covariance => AnySpectrum::Covariance(*c),
-            Form::SquareRoot => AnySpectrum::SquareRoot(AnyFactor::from_cov(c)),
+            Form::SquareRoot => {
+                AnySpectrum::SquareRoot(each!(AnyCov, c, c => AnyFactor::from(CovFactor::from_cov(c))))
+            }
         }
     }
 
@@ -380,7 +357,7 @@ impl AnySpectrum {
     pub fn cov(&self) -> Result<AnyCov, CovError> {
         match self {
             AnySpectrum::Covariance(c) => Ok(*c),
-            AnySpectrum::SquareRoot(f) => f.to_cov(),
+            AnySpectrum::SquareRoot(f) => each!(AnyFactor, f, f => f.to_cov().map(AnyCov::from)),
         }
     }
 
@@ -388,7 +365,7 @@ impl AnySpectrum {
     pub fn to_cov<const N: usize>(&self) -> Option<Cov<N>> {
         match self {
             AnySpectrum::Covariance(c) => c.to::<N>(),
-            AnySpectrum::SquareRoot(f) => f.to::<N>()?.to_cov().ok(),
+            AnySpectrum::SquareRoot(f) => each!(AnyFactor, f, f => f.cast::<N>())?.to_cov().ok(),
         }
     }
 
@@ -396,7 +373,7 @@ impl AnySpectrum {
     pub fn to_factor<const N: usize>(&self) -> Option<CovFactor<N>> {
         match self {
             AnySpectrum::Covariance(c) => c.to::<N>().map(|c| CovFactor::from_cov(&c)),
-            AnySpectrum::SquareRoot(f) => f.to::<N>(),
+            AnySpectrum::SquareRoot(f) => each!(AnyFactor, f, f => f.cast::<N>()),
         }
     }
 
@@ -404,7 +381,7 @@ impl AnySpectrum {
     pub fn as_spectrum_mut(&mut self) -> &mut dyn Spectrum {
         match self {
             AnySpectrum::Covariance(c) => c.as_spectrum_mut(),
-            AnySpectrum::SquareRoot(f) => f.as_spectrum_mut(),
+            AnySpectrum::SquareRoot(f) => each!(AnyFactor, f, f => f as &mut dyn Spectrum),
         }
     }
 }

@@ -68,15 +68,6 @@ impl Axis {
         }
     }
 
-    /// Unit of a frequency along this axis.
-    pub fn frequency_unit(self) -> &'static str {
-        match self {
-            Axis::X | Axis::Y => "cycles/m",
-            Axis::U | Axis::V => "cycles/tan",
-            Axis::T => "cycles/s",
-        }
-    }
-
     fn bit(self) -> u8 {
         1 << (self as u8)
     }
@@ -112,11 +103,6 @@ impl AxisSet {
     /// Whether `axis` is in the set.
     pub fn contains(self, axis: Axis) -> bool {
         self.0 & axis.bit() != 0
-    }
-
-    /// Whether every axis of `other` is in `self`.
-    pub fn contains_all(self, other: AxisSet) -> bool {
-        self.0 & other.0 == other.0
     }
 
     /// Union of two sets.

@@ -137,7 +137,7 @@ impl<const N: usize> Cov<N> {
         let mut c = Self::zeros();
         for (i, v) in variances.iter().enumerate() {
             let name = Self::axes()[i].name();
-            CovError::require_non_negative("Cov::from_diagonal", name, *v)?;
+            crate::spec::Arg::new("Cov::from_diagonal", name, *v).non_negative()?;
             c.set(i, i, *v);
         }
         Ok(c)
@@ -186,8 +186,7 @@ impl<const N: usize> Cov<N> {
     /// # Errors
     /// Non-finite entries, an asymmetric matrix, or a `c` that is not positive definite.
     pub fn from_primal_covariance(c: &SMatrix<f64, N, N>) -> Result<Self, CovError> {
-        check_matrix_finite("Cov::from_primal_covariance", c.as_slice())?;
-        check_symmetric::<N>(c)?;
+        crate::spectrum::symmetric("Cov::from_primal_covariance", "c", N, |i, j| c[(i, j)])?;
         let chol = nalgebra::Cholesky::new(*c).ok_or_else(|| {
             let mut a = [[0.0; MAX]; MAX];
             for (i, row) in a.iter_mut().enumerate().take(N) {
@@ -226,8 +225,8 @@ impl<const N: usize> Cov<N> {
     /// # Errors
     /// Non-finite or non-positive `scene_scale` (m) or `relative_size`.
     pub fn dirac(scene_scale: f64, relative_size: f64) -> Result<Self, CovError> {
-        CovError::require_positive("Cov::dirac", "scene_scale", scene_scale)?;
-        CovError::require_positive("Cov::dirac", "relative_size", relative_size)?;
+        crate::arg!("Cov::dirac", scene_scale).positive()?;
+        crate::arg!("Cov::dirac", relative_size).positive()?;
         let s = scene_scale * relative_size;
         let v = 1.0 / (FOUR_PI_SQ * s * s);
         let mut c = Self::zeros();
@@ -244,15 +243,14 @@ impl<const N: usize> Cov<N> {
     /// `1e-12 × max|entry|`, then averaged to exact symmetry) and PSD (see [`PSD_RTOL`]).
     ///
     /// # Errors
-    /// [`CovError::Overflow`] (non-finite entry), [`CovError::NotSymmetric`],
+    /// [`CovError::NonFinite`] (an entry, named `m[row·N + col]`), [`CovError::NotSymmetric`],
     /// [`CovError::NotPsd`].
     pub fn from_matrix(m: &SMatrix<f64, N, N>) -> Result<Self, CovError> {
-        check_matrix_finite("Cov::from_matrix", m.as_slice())?;
-        check_symmetric::<N>(m)?;
+        let m = crate::spectrum::symmetric("Cov::from_matrix", "m", N, |i, j| m[(i, j)])?;
         let mut c = Self::zeros();
         for i in 0..N {
             for j in i..N {
-                c.set(i, j, 0.5 * m[(i, j)] + 0.5 * m[(j, i)]);
+                c.set(i, j, m[i][j]);
             }
         }
         let report = c.validity();
@@ -427,35 +425,6 @@ impl fmt::Display for Validity {
             self.finite, self.psd, self.min_eigenvalue, self.tolerance, self.max_eigenvalue, self.condition
         )
     }
-}
-
-fn check_matrix_finite(operator: &str, values: &[f64]) -> Result<(), CovError> {
-    if let Some((k, v)) = values.iter().enumerate().find(|(_, v)| !v.is_finite()) {
-        return Err(CovError::Overflow {
-            operator: operator.into(),
-            row: k % values.len().isqrt().max(1),
-            col: k / values.len().isqrt().max(1),
-            value: *v,
-        });
-    }
-    Ok(())
-}
-
-fn check_symmetric<const N: usize>(m: &SMatrix<f64, N, N>) -> Result<(), CovError> {
-    let scale = m.iter().fold(0.0f64, |a, v| a.max(v.abs()));
-    for i in 0..N {
-        for j in (i + 1)..N {
-            if (m[(i, j)] - m[(j, i)]).abs() > 1e-12 * scale {
-                return Err(CovError::NotSymmetric {
-                    row: i,
-                    col: j,
-                    a: m[(i, j)],
-                    b: m[(j, i)],
-                });
-            }
-        }
-    }
-    Ok(())
 }
 
 impl<const N: usize> From<Cov<N>> for SMatrix<f64, N, N> {

@@ -64,10 +64,10 @@ impl<K: Kernels> Direct<'_, K> {
 
 impl<K: Kernels> Spectrum for Direct<'_, K> {
     fn dim(&self) -> usize {
-        K::DIM
+        self.0.dim()
     }
     fn form(&self) -> Form {
-        K::FORM
+        self.0.form()
     }
     fn cov(&self) -> Result<AnyCov, CovError> {
         self.0.cov()
@@ -118,7 +118,7 @@ impl<K: Kernels> Spectrum for Direct<'_, K> {
     fn raw_add_variance(&mut self, op: &str, i: usize, w: f64) -> Result<(), CovError> {
         // The square-root form folds with reflections, which would spread an ∞ as NaN:
         // the end check still sees it, but check first to keep the fold finite.
-        if K::FORM == Form::SquareRoot {
+        if self.0.form() == Form::SquareRoot {
             self.finite(op)?;
         }
         self.0.k_add_variance(i, w);

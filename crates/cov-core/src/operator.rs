@@ -5,7 +5,7 @@ use std::sync::Arc;
 
 use crate::direct::Direct;
 use crate::form::Kernels;
-use crate::{AnyCov, AnySpectrum, AxisSet, Concrete, Cov, CovError, Form, Report, Spectrum, layout_set};
+use crate::{AnyCov, AnySpectrum, AxisSet, Concrete, Cov, CovError, Form, Report, Spectrum};
 
 /// An event on a light path, acting on the spectrum covariance.
 ///
@@ -415,18 +415,4 @@ impl Operator for Chain {
             .iter()
             .fold(AxisSet::FLAT, |s, op| s.union(op.requires()))
     }
-}
-
-/// Checks that layout `n` has every axis `op` requires.
-///
-/// # Errors
-/// [`CovError::MissingAxis`] naming the first missing axis.
-pub fn check_layout(n: usize, op: &dyn Operator) -> Result<(), CovError> {
-    let have = layout_set(n);
-    for axis in op.requires().iter() {
-        if !have.contains(axis) {
-            return Err(CovError::MissingAxis { axis, layout: n });
-        }
-    }
-    Ok(())
 }

@@ -1,12 +1,11 @@
 //! Queries: what a renderer reads off Σ (docs/physics.md section 4).
 
 use crate::Spectrum;
-use std::f64::consts::PI;
 use std::fmt;
 
 use nalgebra::DMatrix;
 
-use crate::linalg::{MAX, Small, psd_pinv, sym_eigen};
+use crate::linalg::{MAX, Small, sym_eigen};
 use crate::{Axis, Cov, CovError, FOUR_PI_SQ};
 
 /// Default Nyquist factor `k` (dimensionless): a spectrum of std `σ` along an axis is
@@ -192,7 +191,7 @@ impl CovBlock {
     /// # Errors
     /// Non-finite or non-positive `k`.
     pub fn sampling_density(&self, k: f64) -> Result<f64, CovError> {
-        CovError::require_positive("sampling_density", "k", k)?;
+        crate::arg!("sampling_density", k).positive()?;
         Ok((2.0 * k).powi(self.len() as i32) * self.spectrum_volume())
     }
 
@@ -216,8 +215,8 @@ impl CovBlock {
                 got: format!("{} values", max_extent.len()),
             });
         }
-        for (a, e) in self.axes.iter().zip(max_extent) {
-            CovError::require_positive("reconstruction_filter", &format!("max_extent.{a}"), *e)?;
+        for k in 0..n {
+            crate::arg!("reconstruction_filter", max_extent[k]).positive()?;
         }
         let mut st = [[0.0; MAX]; MAX];
         for i in 0..n {
@@ -258,23 +257,6 @@ impl CovBlock {
             directions: DMatrix::from_fn(n, n, |i, j| fvec[i][j]),
             clamped,
         })
-    }
-
-    /// Pseudo-inverse of the block (scaled, see [`crate::linalg::psd_pinv`]) and its rank.
-    pub fn pinv(&self) -> (DMatrix<f64>, usize) {
-        let n = self.len();
-        let (p, r) = psd_pinv(n, &self.m);
-        (DMatrix::from_fn(n, n, |i, j| p[i][j]), r)
-    }
-}
-
-/// Primal std of a Gaussian whose spectrum has variance `sigma2` ((cycles/unit)²):
-/// `1 / (2π √σ²)`; infinite for `σ² = 0`.
-pub fn primal_std_of_spectrum(sigma2: f64) -> f64 {
-    if sigma2 <= 0.0 {
-        f64::INFINITY
-    } else {
-        1.0 / (2.0 * PI * sigma2.sqrt())
     }
 }
 

@@ -251,6 +251,17 @@ pub struct Arg {
 }
 
 impl Arg {
+    /// A value named `name`, given to `operator` (for names that are not an identifier in
+    /// scope; otherwise [`arg!`](crate::arg)).
+    pub const fn new(operator: &'static str, name: &'static str, value: f64) -> Arg {
+        Arg {
+            operator,
+            name,
+            value,
+            index: None,
+        }
+    }
+
     fn param(&self) -> Param {
         Param {
             operator: self.operator,

@@ -12,6 +12,7 @@ use std::fmt;
 
 use crate::axis::{axis_index, layout_axes};
 use crate::linalg::{MAX, Small, sym_eigen};
+use crate::spec::Arg;
 use crate::{AnyCov, AnySpectrum, Axis, Cov, CovError, CovFactor, PSD_RTOL};
 
 /// How a chain holds Σ while it is evaluated.
@@ -199,7 +200,7 @@ pub trait Spectrum: fmt::Debug {
         let mut m = [[0.0; MAX]; MAX];
         for l in 0..n {
             for j in 0..n {
-                m[l][j] = CovError::require_finite("congruence", "A", a[l * n + j])?;
+                m[l][j] = Arg::new("congruence", "A", a[l * n + j]).finite()?;
             }
         }
         self.raw_congruence("congruence", &m)
@@ -214,7 +215,7 @@ pub trait Spectrum: fmt::Debug {
     /// Missing axis, `target == source`, non-finite `s`, or an overflowing result.
     #[inline(always)]
     fn shear(&mut self, target: Axis, source: Axis, s: f64) -> Result<(), CovError> {
-        CovError::require_finite("shear", "s", s)?;
+        crate::arg!("shear", s).finite()?;
         let (i, j) = two_axes(self.dim(), "shear", target, source)?;
         if s == 0.0 {
             return Ok(());
@@ -229,7 +230,7 @@ pub trait Spectrum: fmt::Debug {
     /// Missing axis, non-finite `c`, or an overflowing result.
     #[inline(always)]
     fn scale(&mut self, axis: Axis, c: f64) -> Result<(), CovError> {
-        CovError::require_finite("scale", "c", c)?;
+        crate::arg!("scale", c).finite()?;
         let i = self.index(axis)?;
         self.raw_scale("scale", i, c)
     }
@@ -241,7 +242,7 @@ pub trait Spectrum: fmt::Debug {
     /// Missing axis, `a == b`, non-finite `angle`.
     #[inline(always)]
     fn rotate(&mut self, a: Axis, b: Axis, angle: f64) -> Result<(), CovError> {
-        CovError::require_finite("rotate", "angle", angle)?;
+        crate::arg!("rotate", angle).finite()?;
         let (i, j) = two_axes(self.dim(), "rotate", a, b)?;
         let (s, c) = angle.sin_cos();
         self.raw_rotate("rotate", &[(i, j)], c, s)
@@ -282,7 +283,7 @@ pub trait Spectrum: fmt::Debug {
     /// Missing axis, `w` negative or non-finite, overflow.
     #[inline(always)]
     fn add_variance(&mut self, axis: Axis, w: f64) -> Result<(), CovError> {
-        CovError::require_non_negative("add_variance", "w", w)?;
+        crate::arg!("add_variance", w).non_negative()?;
         let i = self.index(axis)?;
         if w == 0.0 {
             return Ok(());
@@ -317,10 +318,10 @@ pub trait Spectrum: fmt::Debug {
         if let ([axis], [s1]) = (axes, s) {
             // One axis: S is a non-negative number; no eigen-check needed.
             let p = self.index(*axis)?;
-            CovError::require_non_negative("convolve", "S", *s1)?;
+            Arg::new("convolve", "S", *s1).non_negative()?;
             return self.raw_lobe_1("convolve", p, *s1);
         }
-        convolve_block(self, axes, s)
+        lobe_block(self, "convolve", axes, Some(s))
     }
 
     /// Rule 4, in place: integration of the primal over `axes` (lens, shutter, sensor
@@ -337,24 +338,23 @@ pub trait Spectrum: fmt::Debug {
             let p = self.index(*axis)?;
             return self.raw_lobe_1("integrate", p, 0.0);
         }
-        integrate_block(self, axes)
+        lobe_block(self, "integrate", axes, None)
     }
 }
 
-/// [`Spectrum::convolve`] on several axes: checked and run out of line, so that the
-/// one-axis case inlines into a caller that knows its spectrum type.
+/// [`Spectrum::convolve`] (`s` given) or [`Spectrum::integrate`] (`S = 0`) on several
+/// axes: checked and run out of line, so that the one-axis case inlines into a caller that
+/// knows its spectrum type.
 #[inline(never)]
-fn convolve_block<S: Spectrum + ?Sized>(spec: &mut S, axes: &[Axis], s: &[f64]) -> Result<(), CovError> {
-    let (idx, k) = resolve(spec.dim(), "convolve", axes)?;
-    let sm = block_from_slice("convolve", "S", k, s)?;
-    spec.raw_lobe("convolve", &idx[..k], &sm)
-}
-
-/// [`Spectrum::integrate`] on several axes, out of line as [`convolve_block`].
-#[inline(never)]
-fn integrate_block<S: Spectrum + ?Sized>(spec: &mut S, axes: &[Axis]) -> Result<(), CovError> {
-    let (idx, k) = resolve(spec.dim(), "integrate", axes)?;
-    spec.raw_lobe("integrate", &idx[..k], &[[0.0; MAX]; MAX])
+fn lobe_block<S: Spectrum + ?Sized>(
+    spec: &mut S,
+    op: &'static str,
+    axes: &[Axis],
+    s: Option<&[f64]>,
+) -> Result<(), CovError> {
+    let (idx, k) = resolve(spec.dim(), op, axes)?;
+    let sm = s.map_or(Ok([[0.0; MAX]; MAX]), |s| block_from_slice(op, "S", k, s))?;
+    spec.raw_lobe(op, &idx[..k], &sm)
 }
 
 /// What a `&mut dyn Spectrum` holds ([`Spectrum::concrete`]): one of the two forms in one
@@ -392,7 +392,12 @@ pub fn transverse_pairs(n: usize) -> &'static [(Axis, Axis)] {
 
 /// Reads a `k × k` row-major symmetric PSD block (a window or lobe spectrum).
 #[inline(always)]
-pub(crate) fn block_from_slice(op: &str, name: &str, k: usize, w: &[f64]) -> Result<Small, CovError> {
+pub(crate) fn block_from_slice(
+    op: &'static str,
+    name: &'static str,
+    k: usize,
+    w: &[f64],
+) -> Result<Small, CovError> {
     if w.len() != k * k {
         return Err(CovError::Shape {
             what: format!("{op}: {name}"),
@@ -400,13 +405,36 @@ pub(crate) fn block_from_slice(op: &str, name: &str, k: usize, w: &[f64]) -> Res
             got: format!("{} numbers", w.len()),
         });
     }
+    let m = symmetric(op, name, k, |a, b| w[a * k + b])?;
+    let (vals, _) = sym_eigen(k, &m);
+    let tol = PSD_RTOL * vals[..k].iter().fold(0.0f64, |acc, v| acc.max(v.abs()));
+    if vals[0] < -tol {
+        return Err(CovError::NotPsd {
+            min_eigenvalue: vals[0],
+            tolerance: -tol,
+        });
+    }
+    Ok(m)
+}
+
+/// Reads the `k × k` matrix `at(row, col)` given to `op` as `name`: every entry finite
+/// (an error names entry `name[row·k + col]`), symmetric to `1e-12 ×` its largest
+/// entry (the rounding of a matrix computed symmetric), then averaged to exact symmetry
+/// as `½a + ½b` (which cannot overflow).
+pub(crate) fn symmetric(
+    op: &'static str,
+    name: &'static str,
+    k: usize,
+    at: impl Fn(usize, usize) -> f64,
+) -> Result<Small, CovError> {
     let mut m = [[0.0; MAX]; MAX];
     let mut scale = 0.0f64;
     for a in 0..k {
         for b in 0..k {
-            let v = CovError::require_finite(op, name, w[a * k + b])?;
-            m[a][b] = v;
-            scale = scale.max(v.abs());
+            let mut arg = Arg::new(op, name, at(a, b));
+            arg.index = Some(a * k + b);
+            m[a][b] = arg.finite()?;
+            scale = scale.max(m[a][b].abs());
         }
     }
     for a in 0..k {
@@ -419,18 +447,10 @@ pub(crate) fn block_from_slice(op: &str, name: &str, k: usize, w: &[f64]) -> Res
                     b: m[b][a],
                 });
             }
-            let avg = 0.5 * (m[a][b] + m[b][a]);
+            let avg = 0.5 * m[a][b] + 0.5 * m[b][a];
             m[a][b] = avg;
             m[b][a] = avg;
         }
-    }
-    let (vals, _) = sym_eigen(k, &m);
-    let tol = PSD_RTOL * vals[..k].iter().fold(0.0f64, |acc, v| acc.max(v.abs()));
-    if vals[0] < -tol {
-        return Err(CovError::NotPsd {
-            min_eigenvalue: vals[0],
-            tolerance: -tol,
-        });
     }
     Ok(m)
 }

@@ -233,7 +233,7 @@ fn from_matrix_validates() {
     let neg = SMatrix::<f64, 2, 2>::new(1.0, 2.0, 2.0, 1.0);
     assert!(matches!(Cov::from_matrix(&neg), Err(CovError::NotPsd { .. })));
     let nan = SMatrix::<f64, 2, 2>::new(1.0, f64::NAN, f64::NAN, 1.0);
-    assert!(matches!(Cov::from_matrix(&nan), Err(CovError::Overflow { .. })));
+    assert!(matches!(Cov::from_matrix(&nan), Err(CovError::NonFinite { .. })));
 }
 
 #[test]

@@ -65,8 +65,6 @@ impl<const N: usize> Spectrum for Cov<N> {
 }
 
 impl<const N: usize> Kernels for Cov<N> {
-    const FORM: Form = Form::Covariance;
-    const DIM: usize = N;
     // `snap_cancelled` writes `v − v`, NaN for a non-finite `v`; every other entry of
     // the lobe is a product or difference with the non-finite input (`∞·0` is NaN).
     const LOBE_1_KEEPS_NON_FINITE: bool = true;

@@ -256,8 +256,6 @@ impl<const N: usize> Spectrum for CovFactor<N> {
 }
 
 impl<const N: usize> Kernels for CovFactor<N> {
-    const FORM: Form = Form::SquareRoot;
-    const DIM: usize = N;
     // Potter's update and its row snap are not audited for this: check before the lobe.
     const LOBE_1_KEEPS_NON_FINITE: bool = false;
 
@@ -606,6 +604,7 @@ fn row_norm<const N: usize>(r: &[f64; N]) -> f64 {
     }
     scale * r.iter().map(|v| (v / scale) * (v / scale)).sum::<f64>().sqrt()
 }
+
 /// Triangularises rows `r0..r1` of `m` (columns `r0..cols`) by Householder reflections
 /// applied from the right to rows `r0..rows`: afterwards row `r` has no entry right of
 /// column `r`. Rows above `r0` must already be zero in columns `≥ r0`.
@@ -613,7 +612,9 @@ fn row_norm<const N: usize>(r: &[f64; N]) -> f64 {
 /// Each reflection is built from the row scaled by its largest entry, so rows anywhere in
 /// `1e-300 … 1e300` neither overflow nor underflow; a zero row is skipped.
 fn lq<const R: usize>(m: &mut [[f64; W]; R], r0: usize, r1: usize, rows: usize, cols: usize) {
-    lq_body(m, r0, r1, rows, cols);
+    for r in r0..r1 {
+        householder_row(m, r, rows, cols);
+    }
 }
 
 /// [`lq`] of a fold (`N` rows, `N + K` columns) with every size and row index a
@@ -632,14 +633,6 @@ fn lq_fold<const N: usize, const K: usize>(m: &mut Work<N>) {
     }
     if N > 4 {
         householder_row(m, 4, N, N + K);
-    }
-}
-
-/// The body of [`lq`]: one reflection per row.
-#[inline(always)]
-fn lq_body<const R: usize>(m: &mut [[f64; W]; R], r0: usize, r1: usize, rows: usize, cols: usize) {
-    for r in r0..r1 {
-        householder_row(m, r, rows, cols);
     }
 }
 

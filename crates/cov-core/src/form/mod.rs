@@ -24,10 +24,6 @@ pub(crate) fn overflow_at(check: Result<(), crate::CovError>) -> Option<(usize, 
 /// share the form's update functions), so the fast and the checked path give the same
 /// bits.
 pub(crate) trait Kernels: crate::Spectrum + Copy + Send + Sync + 'static {
-    /// The form.
-    const FORM: crate::Form;
-    /// The layout size.
-    const DIM: usize;
     /// Whether [`Kernels::k_lobe_1`] leaves some entry non-finite whenever its input
     /// held one (its snap cannot hide an ∞), so that a chain's fast path need not check
     /// finiteness before it: the check at the end sees the overflow.
