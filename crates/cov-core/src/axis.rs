@@ -159,7 +159,7 @@ pub fn layout_set(n: usize) -> AxisSet {
 ///
 /// # Errors
 /// [`CovError::MissingAxis`] when the layout has no such axis.
-#[inline]
+#[inline(always)]
 pub fn axis_index(n: usize, axis: Axis) -> Result<usize, CovError> {
     let i = match (n, axis) {
         (2 | 3, Axis::X) | (4 | 5, Axis::X) => Some(0),

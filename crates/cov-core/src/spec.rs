@@ -277,13 +277,18 @@ impl Arg {
     ///
     /// # Errors
     /// [`CovError::NonFinite`] or [`CovError::OutOfRange`] with `expected`.
-    #[inline]
+    #[inline(always)]
     pub fn require(
         self,
         ok: impl FnOnce(f64) -> bool,
         expected: impl FnOnce() -> String,
     ) -> Result<f64, CovError> {
-        self.param().require_named(self.index, self.value, ok, expected)
+        if self.value.is_finite() && ok(self.value) {
+            return Ok(self.value);
+        }
+        Err(self
+            .param()
+            .fail(self.index, self.value, self.value.is_finite().then(expected)))
     }
 
     /// The value if it is finite.
@@ -299,7 +304,7 @@ impl Arg {
     ///
     /// # Errors
     /// [`CovError::NonFinite`] or [`CovError::OutOfRange`].
-    #[inline]
+    #[inline(always)]
     pub fn positive(self) -> Result<f64, CovError> {
         self.require(|v| v > 0.0, || "must be > 0".into())
     }
@@ -308,7 +313,7 @@ impl Arg {
     ///
     /// # Errors
     /// [`CovError::NonFinite`] or [`CovError::OutOfRange`].
-    #[inline]
+    #[inline(always)]
     pub fn non_negative(self) -> Result<f64, CovError> {
         self.require(|v| v >= 0.0, || "must be ≥ 0".into())
     }

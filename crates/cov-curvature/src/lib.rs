@@ -184,8 +184,10 @@ impl Operator for Curvature {
     fn apply(&self, cov: &mut dyn Spectrum) -> Result<(), CovError> {
         cov_core::typed!(cov, |cov| {
             if self.is_isotropic() {
-                for &(p, d) in cov.transverse_pairs() {
-                    cov.shear(d, p, self.kx)?;
+                // Each plane written out, for constant axes (as `Travel`).
+                cov.shear(Axis::U, Axis::X, self.kx)?;
+                if cov.has(Axis::Y) {
+                    cov.shear(Axis::V, Axis::Y, self.kx)?;
                 }
                 return Ok(());
             }

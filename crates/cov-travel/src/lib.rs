@@ -46,7 +46,7 @@
 
 pub mod spec;
 
-use cov_core::{CovError, Operator, OperatorSpec, Spectrum};
+use cov_core::{Axis, CovError, Operator, OperatorSpec, Spectrum};
 
 /// Travel by `distance` metres along the ray.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -73,9 +73,12 @@ impl Travel {
 
 impl Operator for Travel {
     fn apply(&self, cov: &mut dyn Spectrum) -> Result<(), CovError> {
+        // Each plane written out (not a loop over `transverse_pairs`), so that every
+        // shear has constant axes once the spectrum's type is known.
         cov_core::typed!(cov, |cov| {
-            for &(p, d) in cov.transverse_pairs() {
-                cov.shear(p, d, -self.distance)?;
+            cov.shear(Axis::X, Axis::U, -self.distance)?;
+            if cov.has(Axis::Y) {
+                cov.shear(Axis::Y, Axis::V, -self.distance)?;
             }
             Ok(())
         })

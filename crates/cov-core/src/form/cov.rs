@@ -61,7 +61,7 @@ impl<const N: usize> Spectrum for Cov<N> {
         crate::direct::concrete_cov(self)
     }
 
-    super::checked_kernels!();
+    super::checked_kernels!(line);
 }
 
 impl<const N: usize> Kernels for Cov<N> {
@@ -104,6 +104,20 @@ impl<const N: usize> Kernels for Cov<N> {
     }
     fn k_congruence(&mut self, a: &Small) {
         self.congruence_in_place(a);
+    }
+    #[inline(always)]
+    fn line(&self, j: usize) -> [f64; MAX] {
+        let mut line = [0.0; MAX];
+        for (k, v) in line.iter_mut().enumerate().take(N) {
+            *v = self.get(k, j);
+        }
+        line
+    }
+    #[inline(always)]
+    fn set_line(&mut self, j: usize, line: &[f64; MAX]) {
+        for (k, v) in line.iter().enumerate().take(N) {
+            self.set(k, j, *v);
+        }
     }
     #[inline(always)]
     fn all_finite(&self) -> bool {

@@ -252,7 +252,7 @@ impl<const N: usize> Spectrum for CovFactor<N> {
         crate::direct::concrete_factor(self)
     }
 
-    super::checked_kernels!();
+    super::checked_kernels!(whole);
 }
 
 impl<const N: usize> Kernels for CovFactor<N> {
@@ -291,6 +291,16 @@ impl<const N: usize> Kernels for CovFactor<N> {
     }
     fn k_congruence(&mut self, a: &Small) {
         self.l = self.congruence_new(a);
+    }
+    #[inline(always)]
+    fn line(&self, j: usize) -> [f64; MAX] {
+        let mut line = [0.0; MAX];
+        line[..N].copy_from_slice(&self.l[j]);
+        line
+    }
+    #[inline(always)]
+    fn set_line(&mut self, j: usize, line: &[f64; MAX]) {
+        self.l[j].copy_from_slice(&line[..N]);
     }
     #[inline(always)]
     fn all_finite(&self) -> bool {

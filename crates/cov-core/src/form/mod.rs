@@ -5,6 +5,8 @@
 pub(crate) mod cov;
 mod factor;
 
+use crate::linalg::MAX;
+
 pub use cov::SCHUR_SNAP;
 pub use factor::{CovFactor, ROW_SNAP};
 
@@ -38,6 +40,27 @@ pub(crate) trait Kernels: crate::Spectrum + Copy + Send + Sync + 'static {
     fn k_congruence(&mut self, a: &crate::linalg::Small);
     /// Whether every stored number is finite.
     fn all_finite(&self) -> bool;
+    /// Line `j` as stored, what a one-line kernel (shear, scale) writes: Σ's column `j`
+    /// in the covariance form, `L`'s row `j` in the square-root form.
+    fn line(&self, j: usize) -> [f64; MAX];
+    /// Writes back a [`Kernels::line`].
+    fn set_line(&mut self, j: usize, line: &[f64; MAX]);
+
+    /// [`Kernels::checked`] for a kernel that wrote line `j` only (`old`, its value
+    /// before): `N` numbers checked instead of all of Σ, and no copy of Σ.
+    #[inline(always)]
+    fn line_checked(&mut self, op: &str, j: usize, old: [f64; MAX]) -> Result<(), crate::CovError> {
+        let mut bad = false;
+        for v in &self.line(j)[..self.dim()] {
+            bad |= !v.is_finite();
+        }
+        if !bad {
+            return Ok(());
+        }
+        let mut whole = *self;
+        whole.set_line(j, &old);
+        overflowed(self, op, whole)
+    }
 
     /// The end of a checked kernel: `Ok` if every stored number is finite; otherwise Σ is
     /// restored to `old` and the first non-finite entry is reported as an overflow of `op`.
@@ -72,7 +95,8 @@ fn overflowed<K: Kernels>(k: &mut K, op: &str, old: K) -> Result<(), crate::CovE
 /// arithmetic is written once per form, and the checked and unchecked paths give the same
 /// bits.
 macro_rules! checked_kernels {
-    () => {
+    ($add_variance:ident) => {
+        $crate::form::checked_kernels!(@add_variance $add_variance);
         fn raw_congruence(&mut self, op: &str, a: &Small) -> Result<(), CovError> {
             let old = *self;
             self.k_congruence(a);
@@ -80,15 +104,15 @@ macro_rules! checked_kernels {
         }
         #[inline(always)]
         fn raw_shear(&mut self, op: &str, i: usize, j: usize, s: f64) -> Result<(), CovError> {
-            let old = *self;
+            let old = self.line(j);
             self.k_shear(i, j, s);
-            self.checked(op, old)
+            self.line_checked(op, j, old)
         }
         #[inline(always)]
         fn raw_scale(&mut self, op: &str, i: usize, c: f64) -> Result<(), CovError> {
-            let old = *self;
+            let old = self.line(i);
             self.k_scale(i, c);
-            self.checked(op, old)
+            self.line_checked(op, i, old)
         }
         #[inline(always)]
         fn raw_rotate(
@@ -121,12 +145,6 @@ macro_rules! checked_kernels {
             self.checked(op, old)
         }
         #[inline(always)]
-        fn raw_add_variance(&mut self, op: &str, i: usize, w: f64) -> Result<(), CovError> {
-            let old = *self;
-            self.k_add_variance(i, w);
-            self.checked(op, old)
-        }
-        #[inline(always)]
         fn raw_lobe_1(&mut self, op: &str, p: usize, s: f64) -> Result<(), CovError> {
             // Checked for every `s`, integration too: a Schur complement of a PSD Σ
             // shrinks it, but its rounding near f64's range is not bounded by that.
@@ -138,6 +156,24 @@ macro_rules! checked_kernels {
         fn raw_lobe(&mut self, op: &str, p: &[usize], s: &Small) -> Result<(), CovError> {
             let old = *self;
             self.k_lobe(p, s);
+            self.checked(op, old)
+        }
+    };
+    // A variance that touches line `i` only (the covariance form) or the whole factor
+    // (the square-root form folds it in).
+    (@add_variance line) => {
+        #[inline(always)]
+        fn raw_add_variance(&mut self, op: &str, i: usize, w: f64) -> Result<(), CovError> {
+            let old = self.line(i);
+            self.k_add_variance(i, w);
+            self.line_checked(op, i, old)
+        }
+    };
+    (@add_variance whole) => {
+        #[inline(always)]
+        fn raw_add_variance(&mut self, op: &str, i: usize, w: f64) -> Result<(), CovError> {
+            let old = *self;
+            self.k_add_variance(i, w);
             self.checked(op, old)
         }
     };
