@@ -4,7 +4,10 @@
 //! form, 10⁴-operator chains included. The covariance form is held to 1e-8 there (it
 //! measures 4.1e-9: the reason the square-root form is the default), except on the cases
 //! well conditioned in the parameters but not in Σ's entries (a 1e-9 m window refocused
-//! by a lobe: 2.4e-4 to 8.6e-3 in both forms, reported and not yet asserted). The report:
+//! by a lobe: 2.4e-4 to 8.6e-3 in both forms, reported and not yet asserted). The cases
+//! whose small answer sits next to entries 1e16–1e22 larger (a window far below a beam's
+//! size, a picometre source) are compared without the resolution floor, so losing the
+//! beam's angular spread fails here. The report:
 //! `cargo run --release -p cov-cli -- stiff`.
 
 use cov_stiff::{cases, run};

@@ -421,6 +421,7 @@ pub(crate) fn block_from_slice(
 /// (an error names entry `name[row·k + col]`), symmetric to `1e-12 ×` its largest
 /// entry (the rounding of a matrix computed symmetric), then averaged to exact symmetry
 /// as `½a + ½b` (which cannot overflow).
+#[inline(always)]
 pub(crate) fn symmetric(
     op: &'static str,
     name: &'static str,

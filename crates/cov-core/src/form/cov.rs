@@ -61,13 +61,14 @@ impl<const N: usize> Spectrum for Cov<N> {
         crate::direct::concrete_cov(self)
     }
 
-    super::checked_kernels!(line);
+    super::checked_kernels!(entry);
 }
 
 impl<const N: usize> Kernels for Cov<N> {
     // `snap_cancelled` writes `v − v`, NaN for a non-finite `v`; every other entry of
     // the lobe is a product or difference with the non-finite input (`∞·0` is NaN).
     const LOBE_1_KEEPS_NON_FINITE: bool = true;
+    const ROTATION_STAYS_FINITE: bool = false;
 
     #[inline(always)]
     fn k_shear(&mut self, i: usize, j: usize, s: f64) {

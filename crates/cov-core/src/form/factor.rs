@@ -258,6 +258,7 @@ impl<const N: usize> Spectrum for CovFactor<N> {
 impl<const N: usize> Kernels for CovFactor<N> {
     // Potter's update and its row snap are not audited for this: check before the lobe.
     const LOBE_1_KEEPS_NON_FINITE: bool = false;
+    const ROTATION_STAYS_FINITE: bool = true;
 
     #[inline(always)]
     fn k_shear(&mut self, i: usize, j: usize, s: f64) {

@@ -30,6 +30,9 @@ pub(crate) trait Kernels: crate::Spectrum + Copy + Send + Sync + 'static {
     /// held one (its snap cannot hide an ∞), so that a chain's fast path need not check
     /// finiteness before it: the check at the end sees the overflow.
     const LOBE_1_KEEPS_NON_FINITE: bool;
+    /// Whether a rotation of finite numbers stays finite (the square-root form rotates rows
+    /// of `L`, an orthogonal map), so that its checked kernel needs no check.
+    const ROTATION_STAYS_FINITE: bool;
     fn k_shear(&mut self, i: usize, j: usize, s: f64);
     fn k_scale(&mut self, i: usize, c: f64);
     fn k_rotate(&mut self, i: usize, j: usize, c: f64, s: f64);
@@ -97,6 +100,23 @@ fn overflowed<K: Kernels>(k: &mut K, op: &str, old: K) -> Result<(), crate::CovE
 macro_rules! checked_kernels {
     ($add_variance:ident) => {
         $crate::form::checked_kernels!(@add_variance $add_variance);
+        #[inline(always)]
+        fn raw_rotate(&mut self, op: &str, planes: &[(usize, usize)], c: f64, s: f64) -> Result<(), CovError> {
+            let old = *self;
+            // One or two planes written out, so that constant indices reach the kernel.
+            match *planes {
+                [(i, j)] => self.k_rotate(i, j, c, s),
+                [(i, j), (k, l)] => {
+                    self.k_rotate(i, j, c, s);
+                    self.k_rotate(k, l, c, s);
+                }
+                _ => planes.iter().for_each(|&(i, j)| self.k_rotate(i, j, c, s)),
+            }
+            if Self::ROTATION_STAYS_FINITE {
+                return Ok(());
+            }
+            self.checked(op, old)
+        }
         fn raw_congruence(&mut self, op: &str, a: &Small) -> Result<(), CovError> {
             let old = *self;
             self.k_congruence(a);
@@ -113,30 +133,6 @@ macro_rules! checked_kernels {
             let old = self.line(i);
             self.k_scale(i, c);
             self.line_checked(op, i, old)
-        }
-        #[inline(always)]
-        fn raw_rotate(
-            &mut self,
-            op: &str,
-            planes: &[(usize, usize)],
-            c: f64,
-            s: f64,
-        ) -> Result<(), CovError> {
-            let old = *self;
-            // One or two planes written out, so that constant indices reach the kernel.
-            match *planes {
-                [(i, j)] => self.k_rotate(i, j, c, s),
-                [(i, j), (k, l)] => {
-                    self.k_rotate(i, j, c, s);
-                    self.k_rotate(k, l, c, s);
-                }
-                _ => {
-                    for &(i, j) in planes {
-                        self.k_rotate(i, j, c, s);
-                    }
-                }
-            }
-            self.checked(op, old)
         }
         #[inline]
         fn raw_add_window(&mut self, op: &str, p: &[usize], w: &Small) -> Result<(), CovError> {
@@ -159,14 +155,19 @@ macro_rules! checked_kernels {
             self.checked(op, old)
         }
     };
-    // A variance that touches line `i` only (the covariance form) or the whole factor
-    // (the square-root form folds it in).
-    (@add_variance line) => {
+    // A variance that touches one entry (the covariance form's `Σ_ii`) or the whole
+    // factor (the square-root form folds it in).
+    (@add_variance entry) => {
         #[inline(always)]
         fn raw_add_variance(&mut self, op: &str, i: usize, w: f64) -> Result<(), CovError> {
-            let old = self.line(i);
+            let old = self.get(i, i);
             self.k_add_variance(i, w);
-            self.line_checked(op, i, old)
+            if self.get(i, i).is_finite() {
+                return Ok(());
+            }
+            let mut line = self.line(i);
+            line[i] = old;
+            self.line_checked(op, i, line)
         }
     };
     (@add_variance whole) => {
