@@ -46,10 +46,10 @@
 //! decisions ([`SCHUR_SNAP`] on Σ, [`ROW_SNAP`] `= √SCHUR_SNAP` on the factor's rows): an
 //! entry or row that cancelled below it is set to 0, which errs towards a smaller
 //! bandwidth and is exact only when the true value is 0. A small variance well determined
-//! by the parameters but not by Σ's entries (a 1e-9 m window refocused by a lobe) is kept
-//! by the square-root form (≤ 1.5e-16 relative on the stiff suite: a row that cancels
-//! keeps its component along the lobe's row, scaled exactly as that row is) and lost by
-//! the covariance form (2.4e-4 to 0.81 relative, towards a smaller bandwidth).
+//! by the parameters but not by Σ's entries (a window far below a beam's size, refocused
+//! by a lobe) is kept by the square-root form (≤ 1.9e-15 on the stiff suite: a cancelled
+//! row is rebuilt from its component along the lobe's row and its orthogonal part, both
+//! computed without cancellation) and lost by the covariance form (up to 100%).
 //!
 //! ```
 //! use cov_core::{Axis, Cov, CovError, Spectrum};
