@@ -21,17 +21,17 @@ pub(crate) fn overflow_at(check: Result<(), crate::CovError>) -> Option<(usize, 
 /// The unchecked in-place kernels of a concrete form, for the fast path of a
 /// [`crate::Chain`] (`Direct`). Indices arrive resolved and parameters checked; these
 /// kernels do not check their output: ∞ and NaN propagate, and the chain checks
-/// finiteness where a later kernel could hide them and at the end. Each runs the same
-/// arithmetic as the matching checked `raw_*` kernel of [`crate::Spectrum`] (the two
-/// share the form's update functions), so the fast and the checked path give the same
-/// bits.
+/// finiteness where a later kernel could hide them and at the end. The checked `raw_*`
+/// kernels of [`crate::Spectrum`] are these kernels plus a check ([`checked_kernels!`]),
+/// so the fast and the checked path give the same bits.
 pub(crate) trait Kernels: crate::Spectrum + Copy + Send + Sync + 'static {
     /// Whether [`Kernels::k_lobe_1`] leaves some entry non-finite whenever its input
     /// held one (its snap cannot hide an ∞), so that a chain's fast path need not check
     /// finiteness before it: the check at the end sees the overflow.
     const LOBE_1_KEEPS_NON_FINITE: bool;
-    /// Whether a rotation of finite numbers stays finite (the square-root form rotates rows
-    /// of `L`, an orthogonal map), so that its checked kernel needs no check.
+    /// Whether the checked rotation may skip its check: the square-root form rotates rows
+    /// of `L` (an orthogonal map keeps their norms, so an entry overflows only within √2
+    /// of f64's largest, which a chain's end check and `CovFactor::to_cov` report).
     const ROTATION_STAYS_FINITE: bool;
     fn k_shear(&mut self, i: usize, j: usize, s: f64);
     fn k_scale(&mut self, i: usize, c: f64);
