@@ -1,6 +1,7 @@
-//! The unchecked fast path of [`crate::Chain`]: its operators run on the forms' unchecked
-//! kernels ([`Kernels`]), with one finiteness check at the end instead of a check and a
-//! commit per kernel. Operators validate their parameters and resolve their axes as
+//! The fast path of [`crate::Chain`]: its operators run on a copy of Σ with one
+//! finiteness check at the end instead of a check after every step. Bodies written on
+//! `&mut dyn Spectrum` run here on the forms' unchecked kernels ([`Kernels`]); typed
+//! bodies ([`crate::typed!`]) get the concrete form and its checked kernels, inlined. Operators validate their parameters and resolve their axes as
 //! usual; a run that is not clean is repeated in checked mode by the caller, which reports
 //! the failing step exactly and leaves Σ as it was.
 
@@ -84,6 +85,10 @@ impl<K: Kernels> Spectrum for Direct<'_, K> {
     fn first_non_finite(&self) -> Option<(usize, usize, f64)> {
         self.0.first_non_finite()
     }
+    /// The concrete form itself: an operator written with [`crate::typed!`] then runs
+    /// its body on the form's checked kernels, inlined with constant axes (measured
+    /// cheaper than its body on these unchecked kernels through `dyn`); a body written on
+    /// `&mut dyn Spectrum` runs on the unchecked kernels here.
     fn concrete(&mut self) -> crate::Concrete<'_> {
         self.0.concrete()
     }

@@ -225,8 +225,8 @@ impl Chain {
     }
 
     /// The fast path on a concrete form, on a copy of Σ committed if it ran clean: the
-    /// operators on the unchecked kernels ([`Direct`]), with one finiteness check at the
-    /// end. Otherwise the checked path, which finds and reports the failing step and
+    /// operators through [`Direct`] (typed bodies on the checked kernels, others on the
+    /// unchecked ones), with one finiteness check at the end and no per-step check. Otherwise the checked path, which finds and reports the failing step and
     /// leaves Σ as it was.
     fn apply_fast<K: Kernels>(&self, k: &mut K) -> Result<(), CovError> {
         let mut work = *k;
@@ -386,8 +386,8 @@ fn apply_step(index: usize, op: &dyn Operator, c: &mut dyn Spectrum) -> Result<(
 }
 
 impl Operator for Chain {
-    /// On `Cov<N>` and `CovFactor<N>` this runs the operators on the unchecked kernels and
-    /// checks finiteness once, at the end; it falls back to the checked steps only if
+    /// On `Cov<N>` and `CovFactor<N>` this runs the operators on a copy of Σ (see
+    /// `direct.rs`) and checks finiteness once, at the end; it falls back to the checked steps only if
     /// that result is not clean, so errors name the same step, operator and value as the
     /// checked path, and Σ is left as it was on error. Other spectra take the checked
     /// path.

@@ -94,7 +94,8 @@ fn overflowed<K: Kernels>(k: &mut K, op: &str, old: K) -> Result<(), crate::CovE
 
 /// The checked raw kernels of [`crate::Spectrum`] for a form, each derived from the
 /// form's unchecked kernel ([`Kernels`]): the kernel runs in place, then
-/// [`Kernels::checked`] restores Σ and reports if the result overflowed. So each rule's
+/// [`Kernels::checked`] (or [`Kernels::line_checked`] for a kernel that wrote one line)
+/// restores what it wrote and reports if the result overflowed. So each rule's
 /// arithmetic is written once per form, and the checked and unchecked paths give the same
 /// bits.
 macro_rules! checked_kernels {
