@@ -9,6 +9,7 @@
 //! wide filters off the edges the pass saw; the `guard` module checks the filters against
 //! the samples.
 
+use std::ops::Range;
 use std::time::Instant;
 
 use crate::covpass::{CovMaps, PixelCov};
@@ -139,14 +140,21 @@ fn ring(x: i64, y: i64, rho: i64) -> impl Iterator<Item = (i64, i64)> {
 /// Narrows every filter so that it does not reach, at [`EDGE_REACH`] of its own std, a
 /// pixel whose filter is narrower than the distance to it over [`EDGE_REACH`]: a wide
 /// filter stops short of an edge the covariance pass saw a few pixels away.
-pub fn edge_clamp(width: u32, height: u32, raw: &[Gaussian]) -> Vec<Gaussian> {
+///
+/// Only the pixels of `rows` are narrowed (a part of a render, [`crate::parts`]); the
+/// others keep their raw filter.
+pub fn edge_clamp(width: u32, height: u32, raw: &[Gaussian], rows: Range<u32>) -> Vec<Gaussian> {
     use rayon::prelude::*;
     let (w, h) = (i64::from(width), i64::from(height));
     let stds: Vec<f64> = raw.iter().map(Gaussian::std_max).collect();
+    let (r0, r1) = (i64::from(rows.start) * w, i64::from(rows.end.min(height)) * w);
     (0..w * h)
         .into_par_iter()
         .map(|i| {
             let g = raw[i as usize];
+            if i < r0 || i >= r1 {
+                return g;
+            }
             let s = g.std_max();
             let mut limit = s;
             // Rings of growing Chebyshev radius ρ: a pixel on ring ρ is at least ρ away, so
@@ -226,9 +234,9 @@ impl Guide {
     }
 }
 
-/// Per pixel, the relative standard deviation of a sample, `√(σ² / (μ² + ε))`, blurred
-/// over 3×3 pixels (a pilot's variances are noisy).
-pub(crate) fn relative_variance(film: &Film) -> Vec<f64> {
+/// Per pixel of `rows` (0 elsewhere), the relative standard deviation of a sample,
+/// `√(σ² / (μ² + ε))`, blurred over 3×3 pixels (a pilot's variances are noisy).
+pub(crate) fn relative_variance(film: &Film, rows: Range<u32>) -> Vec<f64> {
     let (w, h) = (film.width as i64, film.height as i64);
     let var = film.variance();
     let box_img = film.box_image();
@@ -242,6 +250,9 @@ pub(crate) fn relative_variance(film: &Film) -> Vec<f64> {
         .collect();
     (0..w * h)
         .map(|i| {
+            if !rows.contains(&((i / w) as u32)) {
+                return 0.0;
+            }
             let (s, k) = around(w, h, i, 1).fold((0.0, 0.0), |(s, k), (j, _)| (s + raw[j], k + 1.0));
             s / k
         })

@@ -567,6 +567,24 @@ pub fn covariance_maps(
     seed: u64,
     progress: crate::film::Progress<'_>,
 ) -> Result<CovMaps, crate::RenderError> {
+    covariance_rows(world, paths, stride, seed, 0..world.camera.height, progress)
+}
+
+/// [`covariance_maps`] of the tiles whose first row lies in `rows` (a part of a render,
+/// [`crate::parts`]); the other pixels keep [`PixelCov::default`]. Each tile draws from
+/// its own generator, seeded by its index in the whole image, so a tile's values are the
+/// same whichever rows are traced.
+///
+/// # Errors
+/// As [`covariance_maps`].
+pub fn covariance_rows(
+    world: &World,
+    paths: u32,
+    stride: u32,
+    seed: u64,
+    rows: std::ops::Range<u32>,
+    progress: crate::film::Progress<'_>,
+) -> Result<CovMaps, crate::RenderError> {
     use rayon::prelude::*;
     if !STRIDES.contains(&stride) {
         return Err(crate::RenderError::setting(
@@ -584,11 +602,14 @@ pub fn covariance_maps(
     }
     let cc = CovCamera::new(world).map_err(|e| crate::RenderError::Camera(e.to_string()))?;
     let (w, h) = (world.camera.width, world.camera.height);
-    let tl = crate::film::tiles(w, h);
+    let tl: Vec<(usize, (u32, u32, u32, u32))> = crate::film::tiles(w, h)
+        .into_iter()
+        .enumerate()
+        .filter(|(_, t)| rows.contains(&t.1))
+        .collect();
     let results: Result<Vec<Vec<PixelCov>>, crate::RenderError> = tl
         .par_iter()
-        .enumerate()
-        .map(|(index, &(x0, y0, x1, y1))| {
+        .map(|&(index, (x0, y0, x1, y1))| {
             let mut rng = tile_rng(seed, index);
             let mut out = vec![PixelCov::default(); ((x1 - x0) * (y1 - y0)) as usize];
             for by in (y0..y1).step_by(stride as usize) {
@@ -611,7 +632,13 @@ pub fn covariance_maps(
     Ok(CovMaps {
         width: w,
         height: h,
-        pixels: assemble(w, h, &tl, results?, PixelCov::default()),
+        pixels: assemble(
+            w,
+            h,
+            &tl.iter().map(|t| t.1).collect::<Vec<_>>(),
+            results?,
+            PixelCov::default(),
+        ),
         paths_per_block: paths,
         stride,
         layout: cc.layout(),

@@ -443,8 +443,23 @@ impl Film {
         max_luminance: f64,
         progress: Progress<'_>,
     ) {
+        self.render_rows(world, counts, seed, max_luminance, 0..self.height, progress);
+    }
+
+    /// [`Film::render`] of the tiles whose first row lies in `rows` (a part of a render,
+    /// [`crate::parts`]); `progress` is called once per such tile.
+    pub fn render_rows(
+        &mut self,
+        world: &World,
+        counts: &[u32],
+        seed: u64,
+        max_luminance: f64,
+        rows: std::ops::Range<u32>,
+        progress: Progress<'_>,
+    ) {
         let w = self.width;
-        let tl = tiles(self.width, self.height);
+        let mut tl = tiles(self.width, self.height);
+        tl.retain(|t| rows.contains(&t.1));
         for batch in tl.chunks(BATCH) {
             let outs: Vec<TileOut> = batch
                 .par_iter()

@@ -238,6 +238,11 @@ impl Geometry {
         Geometry { prims: ordered, bvh }
     }
 
+    /// The same primitives under a BVH for the times `t0..t1` (an animation's frame).
+    pub fn retimed(&self, t0: f64, t1: f64) -> Geometry {
+        Geometry::new(self.prims.clone(), t0, t1)
+    }
+
     /// Number of primitives.
     pub fn len(&self) -> usize {
         self.prims.len()

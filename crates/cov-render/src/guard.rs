@@ -33,6 +33,8 @@
 //!
 //! Its cost, one splat per candidate and 3×3 sums, counts in the reconstruction time.
 
+use std::ops::Range;
+
 use glam::DVec3;
 use rayon::prelude::*;
 
@@ -60,18 +62,23 @@ type Candidate<'a> = (&'a [Gaussian], Vec<(DVec3, f64)>);
 
 /// The per-pixel filters of every candidate but the box, in the order of [`SCALES`]
 /// ([`candidate`]). They depend on the guide alone, so a render makes them once.
-pub fn candidates(guide: &Guide) -> Vec<Vec<Gaussian>> {
-    SCALES.iter().map(|&s| candidate(guide, s)).collect()
+/// Only the pixels of `rows` are kept off the edges ([`edge_clamp`]).
+pub fn candidates(guide: &Guide, rows: Range<u32>) -> Vec<Vec<Gaussian>> {
+    SCALES
+        .iter()
+        .map(|&s| candidate(guide, s, rows.clone()))
+        .collect()
 }
 
-/// The per-pixel filters of candidate `scale`: `scale · F₀`, kept off the pass's edges.
-pub fn candidate(guide: &Guide, scale: f64) -> Vec<Gaussian> {
+/// The per-pixel filters of candidate `scale`: `scale · F₀`, kept off the pass's edges
+/// in `rows`.
+pub fn candidate(guide: &Guide, scale: f64, rows: Range<u32>) -> Vec<Gaussian> {
     let raw: Vec<Gaussian> = guide
         .matched
         .iter()
         .map(|f| Gaussian::from_cov(f.map(|v| v * scale)))
         .collect();
-    edge_clamp(guide.width, guide.height, &raw)
+    edge_clamp(guide.width, guide.height, &raw, rows)
 }
 
 /// Reconstructs `film`'s reflected light with the guard (module docs). With `target`
@@ -81,9 +88,11 @@ pub fn candidate(guide: &Guide, scale: f64) -> Vec<Gaussian> {
 /// above the noise is taken for bias, which more samples do not remove (the conservative
 /// reading: a pilot's noise must not hide detail the full budget will show).
 ///
-/// `candidates` are [`candidates`] of the film's guide.
-pub fn guarded(candidates: &[Vec<Gaussian>], film: &Film, target: f64) -> Guarded {
+/// `candidates` are [`candidates`] of the film's guide. Only the pixels of `rows` are
+/// estimated and chosen (a part of a render, [`crate::parts`]); the others take the box.
+pub fn guarded(candidates: &[Vec<Gaussian>], film: &Film, target: f64, rows: Range<u32>) -> Guarded {
     let (w, h) = (film.width as i64, film.height as i64);
+    let inside = |p: usize| rows.contains(&((p as i64 / w.max(1)) as u32));
     let n = film.count.len();
     let var = film.variance();
     let x: Vec<DVec3> = (0..n)
@@ -102,7 +111,7 @@ pub fn guarded(candidates: &[Vec<Gaussian>], film: &Film, target: f64) -> Guarde
         })
         .collect();
     // The normaliser of the relative error: the squared 3×3 mean luminance.
-    let norm: Vec<f64> = box3(w, h, &lx).iter().map(|m| m * m + REL_EPS).collect();
+    let norm: Vec<f64> = box3(w, h, &lx, &rows).iter().map(|m| m * m + REL_EPS).collect();
     let mut risks: Vec<Vec<f64>> = Vec::with_capacity(candidates.len() + 1);
     let mut images: Vec<Candidate<'_>> = Vec::with_capacity(candidates.len());
     for filters in candidates {
@@ -112,7 +121,7 @@ pub fn guarded(candidates: &[Vec<Gaussian>], film: &Film, target: f64) -> Guarde
             .map(|p| {
                 let c = f64::from(film.count[p]);
                 let (sum, wsum) = acc[p];
-                if c == 0.0 || wsum <= 0.0 {
+                if c == 0.0 || wsum <= 0.0 || !inside(p) {
                     return f64::INFINITY;
                 }
                 let own = filters[p].peak();
@@ -126,18 +135,19 @@ pub fn guarded(candidates: &[Vec<Gaussian>], film: &Film, target: f64) -> Guarde
                 (alpha * alpha * s2_target[p] + (1.0 - alpha).powi(2) * (cv - s2[p]).max(0.0)) / norm[p]
             })
             .collect();
-        risks.push(box3(w, h, &risk));
+        risks.push(box3(w, h, &risk, &rows));
         images.push((filters.as_slice(), acc));
     }
     risks.push(box3(
         w,
         h,
         &(0..n).map(|p| s2_target[p] / norm[p]).collect::<Vec<_>>(),
+        &rows,
     ));
     let choice: Vec<u8> = (0..n)
         .map(|p| {
             let mut best = SCALES.len();
-            for k in 0..SCALES.len() {
+            for k in (0..SCALES.len()).filter(|_| inside(p)) {
                 if risks[k][p] < risks[best][p] {
                     best = k;
                 }
@@ -157,12 +167,16 @@ pub fn guarded(candidates: &[Vec<Gaussian>], film: &Film, target: f64) -> Guarde
     Guarded { reflected, filters }
 }
 
-/// The 3×3 mean of `v` (fewer pixels at the borders; an infinite value stays infinite).
-fn box3(w: i64, h: i64, v: &[f64]) -> Vec<f64> {
+/// The 3×3 mean of `v` in `rows` (fewer pixels at the borders; an infinite value stays
+/// infinite); 0 outside `rows`.
+fn box3(w: i64, h: i64, v: &[f64], rows: &Range<u32>) -> Vec<f64> {
     (0..w * h)
         .into_par_iter()
         .map(|i| {
             let (x, y) = (i % w, i / w);
+            if !rows.contains(&(y as u32)) {
+                return 0.0;
+            }
             let (mut s, mut k) = (0.0, 0.0);
             for yy in (y - 1).max(0)..=(y + 1).min(h - 1) {
                 for xx in (x - 1).max(0)..=(x + 1).min(w - 1) {

@@ -35,6 +35,7 @@
 //! | [`adaptive`] | sample allocation and per-pixel filters from the maps |
 //! | [`guard`] | the samples check the maps' filters, pixel by pixel |
 //! | [`renderer`] | one renderer for every method: [`Renderer`], [`RenderSettings`] |
+//! | [`parts`] | a render split into parts (a Slurm job array), merged exactly |
 //! | [`denoise`] | Intel Open Image Denoise after reconstruction (feature `oidn`) |
 //! | [`metrics`], [`mod@bench`] | image error against a reference; error against time |
 //! | [`output`], [`validate`] | files written; the maps checked against reference images |
@@ -54,6 +55,7 @@ pub mod guard;
 pub mod material;
 pub mod metrics;
 pub mod output;
+pub mod parts;
 pub mod renderer;
 pub mod sampler;
 pub mod scene;

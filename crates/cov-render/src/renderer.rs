@@ -34,16 +34,18 @@
 //! generators seeded by the seed and the tile; results are added in a fixed order, so an
 //! image does not depend on the number of threads.
 
+use std::ops::Range;
 use std::time::Instant;
 
 use glam::DVec3;
 
 use crate::RenderError;
-use crate::adaptive::{Guide, MAX_RATIO, allocate, allocate_floors, filter_area, relative_variance};
-use crate::covpass::{CovMaps, MAX_COV_PATHS, STRIDES, covariance_maps};
+use crate::adaptive::{Guide, MAX_RATIO, allocate_floors, filter_area, relative_variance};
+use crate::covpass::{CovMaps, MAX_COV_PATHS, STRIDES, covariance_rows};
 use crate::denoise::Denoise;
 use crate::film::{Film, Filter, Gaussian, Image, MAX_SPP, Progress};
 use crate::guard::{candidate, candidates, guarded};
+use crate::parts::{Part, PartFilm, Window};
 use crate::world::World;
 
 /// Std of the fixed Gaussian filter of the `gauss` baseline (px).
@@ -253,7 +255,11 @@ pub struct Renderer<'w> {
     world: &'w World,
     settings: RenderSettings,
     maps: Option<CovMaps>,
+    /// The rows `maps` were traced over.
+    maps_rows: Range<u32>,
     guide: Option<Guide>,
+    /// Whether `guide` was given ([`Renderer::with_guide`]) rather than traced.
+    guide_given: bool,
 }
 
 impl<'w> Renderer<'w> {
@@ -267,7 +273,9 @@ impl<'w> Renderer<'w> {
             world,
             settings,
             maps: None,
+            maps_rows: 0..0,
             guide: None,
+            guide_given: false,
         })
     }
 
@@ -295,6 +303,7 @@ impl<'w> Renderer<'w> {
             });
         }
         self.guide = Some(guide);
+        self.guide_given = true;
         Ok(self)
     }
 
@@ -304,35 +313,17 @@ impl<'w> Renderer<'w> {
     /// # Errors
     /// An operator that rejects what the scene gives it, with the pixel.
     pub fn trace_covariance(&mut self, progress: Progress<'_>) -> Result<&CovMaps, RenderError> {
-        let maps = match self.maps.take() {
-            Some(m) => m,
-            None => {
-                let s = &self.settings;
-                let (maps, secs) =
-                    timed(|| covariance_maps(self.world, s.cov_paths, s.cov_stride, s.seed, progress));
-                let maps = maps?;
-                if self.guide.is_none() {
-                    self.guide = Some(Guide::new(&maps, secs));
-                }
-                maps
-            }
-        };
-        Ok(self.maps.insert(maps))
+        self.trace_rows(0..self.world.camera.height, progress)?;
+        self.maps
+            .as_ref()
+            .ok_or_else(|| RenderError::Camera("the covariance pass left no maps".into()))
     }
 
     /// How many times one [`Renderer::render`] without a time limit calls its progress
     /// callback: once per tile of every pass, and of the covariance pass when it is still
     /// to be traced.
     pub fn progress_len(&self) -> usize {
-        let tiles = crate::film::tile_count(self.world);
-        let s = &self.settings;
-        let cov = usize::from(s.method.uses_covariance() && self.guide.is_none());
-        let passes = if s.method.has_pilot() && variance_pilot(s.spp).is_some() {
-            2
-        } else {
-            1
-        };
-        tiles * (cov + passes)
+        self.window_progress_len(&Window::whole(self.world.camera.height))
     }
 
     /// The covariance maps, once traced.
@@ -352,10 +343,122 @@ impl<'w> Renderer<'w> {
     /// # Errors
     /// The covariance pass's errors ([`Renderer::trace_covariance`]).
     pub fn render(&mut self, progress: Progress<'_>) -> Result<Rendered, RenderError> {
+        let win = Window::whole(self.world.camera.height);
+        let (film, mut timing, passes, cands) = self.sample(&win, progress)?;
+        let method = self.settings.method;
+        let guide = self.guide.as_ref().filter(|_| method.uses_covariance());
+        let image = reconstruct(method, guide, &cands, &film, self.settings.denoise, &mut timing)?;
+        Ok(Rendered {
+            method,
+            budget: self.settings.spp,
+            passes,
+            samples: film.count.iter().map(|&c| u64::from(c)).sum(),
+            image,
+            film,
+            timing,
+        })
+    }
+
+    /// Renders one part of the image ([`crate::parts`]): the rows `part` owns, with the
+    /// covariance pass and the pilot over the margins their filters need. The image is not
+    /// reconstructed: [`crate::parts::merge`] does that from all the parts.
+    ///
+    /// # Errors
+    /// More parts than the image has allocation bands; a time limit (a part renders a fixed
+    /// budget); the covariance pass's errors.
+    pub fn render_part(&mut self, part: Part, progress: Progress<'_>) -> Result<PartFilm, RenderError> {
+        if self.settings.time.is_some() {
+            return Err(RenderError::setting(
+                "time",
+                "left out when rendering a part (a part renders a fixed budget)",
+                self.settings.time.unwrap_or_default(),
+            ));
+        }
+        let win = part.window(self.world.camera.height)?;
+        let (film, timing, _, _) = self.sample(&win, progress)?;
+        Ok(PartFilm::new(
+            self.world,
+            &self.settings,
+            part,
+            &win,
+            &film,
+            self.maps.as_ref(),
+            timing,
+        ))
+    }
+
+    /// How many times [`Renderer::render_part`] calls its progress callback.
+    ///
+    /// # Errors
+    /// As [`Part::window`].
+    pub fn part_progress_len(&self, part: Part) -> Result<usize, RenderError> {
+        let win = part.window(self.world.camera.height)?;
+        Ok(self.window_progress_len(&win))
+    }
+
+    /// Progress calls of a render of `win`: one per tile of each stage.
+    fn window_progress_len(&self, win: &Window) -> usize {
+        let (w, s) = (self.world.camera.width, &self.settings);
+        let tiles = |r: &Range<u32>| {
+            crate::film::tiles(w, self.world.camera.height)
+                .iter()
+                .filter(|t| r.contains(&t.1))
+                .count()
+        };
+        let cov = if s.method.uses_covariance() && !self.guide_given && !self.has_maps(&win.guide) {
+            tiles(&win.guide)
+        } else {
+            0
+        };
+        let pilot = if s.method.has_pilot() && variance_pilot(s.spp).is_some() {
+            tiles(&win.pilot)
+        } else {
+            0
+        };
+        cov + pilot + tiles(&win.owned)
+    }
+
+    /// Whether maps of `rows` exist.
+    fn has_maps(&self, rows: &Range<u32>) -> bool {
+        self.maps.is_some() && self.maps_rows.start <= rows.start && rows.end <= self.maps_rows.end
+    }
+
+    /// Traces the covariance pass over `rows` unless maps of them exist.
+    fn trace_rows(&mut self, rows: Range<u32>, progress: Progress<'_>) -> Result<(), RenderError> {
+        if self.has_maps(&rows) {
+            return Ok(());
+        }
+        let s = &self.settings;
+        let (maps, secs) = timed(|| {
+            covariance_rows(
+                self.world,
+                s.cov_paths,
+                s.cov_stride,
+                s.seed,
+                rows.clone(),
+                progress,
+            )
+        });
+        let maps = maps?;
+        if !self.guide_given {
+            self.guide = Some(Guide::new(&maps, secs));
+        }
+        self.maps = Some(maps);
+        self.maps_rows = rows;
+        Ok(())
+    }
+
+    /// The samples of `win`'s rows: the covariance pass when the method needs it, the
+    /// pilot and the passes; the film, the timing, the passes and the guard's candidates.
+    fn sample(
+        &mut self,
+        win: &Window,
+        progress: Progress<'_>,
+    ) -> Result<(Film, Timing, u32, Vec<Vec<Gaussian>>), RenderError> {
         let start = Instant::now();
         let method = self.settings.method;
-        if method.uses_covariance() && self.guide.is_none() {
-            self.trace_covariance(progress)?;
+        if method.uses_covariance() && !self.guide_given {
+            self.trace_rows(win.guide.clone(), progress)?;
         }
         let guide = if method.uses_covariance() {
             self.guide.as_ref()
@@ -369,19 +472,23 @@ impl<'w> Renderer<'w> {
         let (world, s) = (self.world, &self.settings);
         let (w, h) = (world.camera.width, world.camera.height);
         let n = w as usize * h as usize;
-        let total = s.spp * n as f64;
         let hi = ((s.spp * MAX_RATIO).ceil() as u32).clamp(1, MAX_SPP);
         let mut film = Film::new(w, h);
-        let sample = |film: &mut Film, counts: &[u32], timing: &mut Timing| {
-            timing.sample(|| film.render(world, counts, s.seed, s.max_luminance, progress));
+        let sample = |film: &mut Film, counts: &[u32], rows: &Range<u32>, timing: &mut Timing| {
+            timing
+                .sample(|| film.render_rows(world, counts, s.seed, s.max_luminance, rows.clone(), progress));
+        };
+        // Samples per pixel in proportion to `weights`, each band of rows its own budget.
+        let bands = |weights: &[f64], floors: &[u32], hi: u32, pow2: bool| {
+            allocate_bands(w, &win.owned, weights, floors, s.spp, hi, pow2)
         };
         // The first pass.
         let (mut counts, t) = timed(|| match (method, guide) {
             (Method::CovDensity, Some(g)) => {
                 let lo = ((s.spp / 4.0).floor() as u32).max(1);
-                allocate(&g.density, total, lo, hi)
+                bands(&g.density, &vec![lo; n], hi, false)
             }
-            _ => allocate(&vec![1.0; n], total, 1, MAX_SPP),
+            _ => bands(&vec![1.0; n], &vec![1; n], MAX_SPP, false),
         });
         // The allocation after a pilot, per pixel: a weight and a floor. The weight is the
         // relative standard deviation (blurred over 3×3 pixels); for covariance tracing,
@@ -395,12 +502,12 @@ impl<'w> Renderer<'w> {
         // helps never gets fewer samples than plain Monte Carlo gives it.
         // The guard's candidate filters, once per render (they depend on the guide alone).
         let (cands, secs) = timed(|| match (method, guide) {
-            (Method::Cov, Some(g)) => candidates(g),
+            (Method::Cov, Some(g)) => candidates(g, win.pilot.clone()),
             _ => Vec::new(),
         });
         timing.allocation += secs;
         let plan = |film: &Film, lo: u32| -> (Vec<f64>, Vec<u32>) {
-            let rv = relative_variance(film);
+            let rv = relative_variance(film, win.pilot.clone());
             match (method, guide) {
                 (Method::CovUnguarded, Some(g)) => (
                     rv.iter()
@@ -410,7 +517,7 @@ impl<'w> Renderer<'w> {
                     vec![lo; n],
                 ),
                 (Method::Cov, Some(_)) => {
-                    let gd = guarded(&cands, film, s.spp);
+                    let gd = guarded(&cands, film, s.spp, win.pilot.clone());
                     let keep = (s.spp.floor() as u32).max(lo);
                     gd.filters
                         .iter()
@@ -427,25 +534,25 @@ impl<'w> Renderer<'w> {
         match method {
             m if m.has_pilot() => {
                 if let Some(p) = variance_pilot(s.spp) {
-                    sample(&mut film, &vec![p; n], &mut timing);
+                    sample(&mut film, &vec![p; n], &win.pilot, &mut timing);
                     let (rest, secs) = timed(|| {
                         let (wts, floors) = plan(&film, p);
-                        allocate_floors(&wts, total, &floors, hi.max(p), true)
+                        bands(&wts, &floors, hi.max(p), true)
                             .into_iter()
                             .map(|c| c.saturating_sub(p))
                             .collect::<Vec<u32>>()
                     });
                     timing.allocation += secs;
-                    sample(&mut film, &rest, &mut timing);
+                    sample(&mut film, &rest, &win.owned, &mut timing);
                 } else {
-                    sample(&mut film, &counts, &mut timing);
+                    sample(&mut film, &counts, &win.owned, &mut timing);
                 }
             }
             _ => {
                 if method == Method::CovDensity {
                     timing.allocation += t;
                 }
-                sample(&mut film, &counts, &mut timing);
+                sample(&mut film, &counts, &win.owned, &mut timing);
             }
         }
         // More passes while the next one is expected to end within the time limit.
@@ -461,61 +568,105 @@ impl<'w> Renderer<'w> {
                 if method.has_pilot() {
                     let (c, secs) = timed(|| {
                         let (wts, floors) = plan(&film, 1);
-                        allocate_floors(&wts, total, &floors, hi, true)
+                        bands(&wts, &floors, hi, true)
                     });
                     timing.allocation += secs;
                     counts = c;
                 }
-                sample(&mut film, &counts, &mut timing);
+                sample(&mut film, &counts, &win.owned, &mut timing);
                 passes += 1;
             }
         }
-        let (image, secs) = timed(|| match (method, guide) {
-            (Method::Cov, Some(_)) => {
-                let gd = guarded(&cands, &film, 0.0);
-                let pixels = (0..n)
-                    .map(|i| match film.count[i] {
-                        0 => DVec3::ZERO,
-                        c => film.emitted[i] / f64::from(c) + gd.reflected[i],
-                    })
-                    .collect();
-                Image {
-                    width: w,
-                    height: h,
-                    pixels,
-                }
-            }
-            _ => {
-                let filter = match (method, guide) {
-                    (Method::Gauss, _) => Filter::Fixed(Gaussian::isotropic(FIXED_STD)),
-                    (Method::CovFilter | Method::CovUnguarded, Some(g)) => {
-                        Filter::PerPixel(candidate(g, 1.0))
-                    }
-                    _ => Filter::Box,
-                };
-                film.image(&filter)
-            }
-        });
-        timing.reconstruction += secs;
-        let image = match s.denoise {
-            Denoise::None => image,
-            d => {
-                let guides = (d == Denoise::Oidn).then(|| film.aovs());
-                let (out, secs) = timed(|| crate::denoise::oidn(&image, guides.as_ref()));
-                timing.denoising += secs;
-                out?
-            }
-        };
-        Ok(Rendered {
-            method,
-            budget: s.spp,
-            passes,
-            samples: film.count.iter().map(|&c| u64::from(c)).sum(),
-            image,
-            film,
-            timing,
-        })
+        Ok((film, timing, passes, cands))
     }
+}
+
+/// Rows of the image whose pixels share one allocation of samples: each band of
+/// `ALLOC_BAND` rows (the last one shorter) spends its own pixels' share of the budget,
+/// distributed by the method's weights. A render split into parts ([`crate::parts`]) gives
+/// each part whole bands, so that the parts' allocations are the single render's. Two
+/// tiles, so that an image of a few hundred rows still splits into several parts, while a
+/// band (two tiles by the image's width) still holds both flat regions and detail.
+pub const ALLOC_BAND: u32 = 2 * crate::film::TILE;
+
+/// Samples per pixel ∝ `weights` between `floors` and `hi` ([`allocate_floors`]), each band
+/// of [`ALLOC_BAND`] rows of `owned` spending `spp` times its pixels; 0 outside `owned`.
+fn allocate_bands(
+    width: u32,
+    owned: &Range<u32>,
+    weights: &[f64],
+    floors: &[u32],
+    spp: f64,
+    hi: u32,
+    pow2: bool,
+) -> Vec<u32> {
+    let w = width as usize;
+    let mut counts = vec![0; weights.len()];
+    let mut y = owned.start;
+    while y < owned.end {
+        let y1 = (y + ALLOC_BAND - y % ALLOC_BAND).min(owned.end);
+        let r = y as usize * w..y1 as usize * w;
+        let c = allocate_floors(
+            &weights[r.clone()],
+            spp * r.len() as f64,
+            &floors[r.clone()],
+            hi,
+            pow2,
+        );
+        counts[r].copy_from_slice(&c);
+        y = y1;
+    }
+    counts
+}
+
+/// The image of `film` with `method`'s reconstruction (`cands`: the guard's candidates over
+/// every row, for [`Method::Cov`]), then the denoiser; the time goes to `timing`.
+pub(crate) fn reconstruct(
+    method: Method,
+    guide: Option<&Guide>,
+    cands: &[Vec<Gaussian>],
+    film: &Film,
+    denoise: Denoise,
+    timing: &mut Timing,
+) -> Result<Image, RenderError> {
+    let (w, h) = (film.width, film.height);
+    let n = film.count.len();
+    let (image, secs) = timed(|| match (method, guide) {
+        (Method::Cov, Some(_)) => {
+            let gd = guarded(cands, film, 0.0, 0..h);
+            let pixels = (0..n)
+                .map(|i| match film.count[i] {
+                    0 => DVec3::ZERO,
+                    c => film.emitted[i] / f64::from(c) + gd.reflected[i],
+                })
+                .collect();
+            Image {
+                width: w,
+                height: h,
+                pixels,
+            }
+        }
+        _ => {
+            let filter = match (method, guide) {
+                (Method::Gauss, _) => Filter::Fixed(Gaussian::isotropic(FIXED_STD)),
+                (Method::CovFilter | Method::CovUnguarded, Some(g)) => {
+                    Filter::PerPixel(candidate(g, 1.0, 0..h))
+                }
+                _ => Filter::Box,
+            };
+            film.image(&filter)
+        }
+    });
+    timing.reconstruction += secs;
+    Ok(match denoise {
+        Denoise::None => image,
+        d => {
+            let guides = (d == Denoise::Oidn).then(|| film.aovs());
+            let (out, secs) = timed(|| crate::denoise::oidn(&image, guides.as_ref()));
+            timing.denoising += secs;
+            out?
+        }
+    })
 }
 
 /// The variance method's pilot: a quarter of the budget, at least 2 samples per pixel

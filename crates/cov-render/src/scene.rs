@@ -29,6 +29,7 @@
 //! | `camera.lens.focal_length` | m | focal length (default 0.05), < focus distance |
 //! | `camera.shutter.open`, `close` | s | shutter interval, `close > open` |
 //! | `camera.velocity` | m/s | camera motion during the shutter |
+//! | `camera.frame_rate` | 1/s | frames per second of an animation (`--frame K` moves the shutter and a still's instant by `K / frame_rate`), default 24 |
 //! | `textures` | | named `Checker(checks, a, b)`, `Stripes(count, duty, a, b)`, `Noise(cells, a, b, seed)` (generated; `size` texels per side, default 1024), `Image(file)` (PNG or EXR, relative to the scene file); all take `repeat: (u, v)` |
 //! | `materials` | | named `Diffuse(albedo)`, `Phong(albedo, exponent)`, `Ggx(albedo, alpha)`, each with an optional `texture` that multiplies the albedo |
 //! | `lights` | | `Rect(corner, edge_u, edge_v, radiance)`, `Sphere(center, radius, radiance)`; radiance in W/(m² sr) per channel |
@@ -178,6 +179,9 @@ pub struct CameraDesc {
     /// Camera velocity during the shutter (m/s).
     #[serde(default)]
     pub velocity: Option<V3>,
+    /// Frames per second of an animation ([`crate::World::at_frame`]); default 24.
+    #[serde(default)]
+    pub frame_rate: Option<Positive>,
 }
 
 /// A thin lens.

@@ -47,6 +47,11 @@ pub struct Camera {
     pub focal_length: f64,
     /// Shutter interval (s), if time is sampled.
     pub shutter: Option<(f64, f64)>,
+    /// Time added to every ray's (s): an animation's frame ([`World::at_frame`]) moves
+    /// the shutter, or a still image's instant, by this much.
+    pub time_offset: f64,
+    /// Frames per second of an animation.
+    pub frame_rate: f64,
     /// Velocity (m/s).
     pub velocity: DVec3,
 }
@@ -70,7 +75,7 @@ impl Camera {
         let nx = (2.0 * px / self.width as f64 - 1.0) * self.tan_x;
         let ny = (1.0 - 2.0 * py / self.height as f64) * self.tan_y;
         let pin = (self.forward + self.right * nx + self.up * ny).normalize();
-        let time = self.shutter.map_or(0.0, |(a, b)| a + (b - a) * ut);
+        let time = self.time_offset + self.shutter.map_or(0.0, |(a, b)| a + (b - a) * ut);
         let centre = self.position + self.velocity * time;
         if self.lens_radius <= 0.0 {
             return CameraRay {
@@ -271,6 +276,11 @@ impl Light {
 pub struct World {
     /// The file it came from.
     pub file: String,
+    /// A hash (FNV-1a, 64 bits) of the scene's text and of every file it reads (textures,
+    /// OBJ meshes): what tells renders of different scenes apart ([`crate::parts`]).
+    pub fingerprint: u64,
+    /// The animation frame the camera and the objects are at ([`World::at_frame`]).
+    pub frame: u32,
     /// The camera.
     pub camera: Camera,
     /// Materials, by index.
@@ -302,6 +312,29 @@ impl World {
         self.camera.height = h;
         self.camera.tan_y = self.camera.tan_x * h as f64 / w as f64;
         self
+    }
+
+    /// The same scene at frame `frame` of an animation: the shutter (or a still's instant)
+    /// moves by `frame / frame_rate` seconds, so that the camera and the objects are where
+    /// their velocities take them by then. Frames count from the scene as written (frame
+    /// 0); up to [`MAX_FRAME`].
+    ///
+    /// # Errors
+    /// A frame above [`MAX_FRAME`].
+    pub fn at_frame(mut self, frame: u32) -> Result<World, crate::RenderError> {
+        if frame > MAX_FRAME {
+            return Err(crate::RenderError::setting(
+                "frame",
+                format!("0 to {MAX_FRAME}"),
+                frame,
+            ));
+        }
+        let c = &mut self.camera;
+        c.time_offset = f64::from(frame) / c.frame_rate;
+        let (t0, t1) = c.shutter.unwrap_or((0.0, 0.0));
+        self.geometry = self.geometry.retimed(t0 + c.time_offset, t1 + c.time_offset);
+        self.frame = frame;
+        Ok(self)
     }
 
     /// The material at a surface hit, its albedo multiplied by its texture's colour there,
@@ -381,6 +414,8 @@ impl World {
         let (t0, t1) = camera.shutter.unwrap_or((0.0, 0.0));
         Ok(World {
             file: file.to_string(),
+            fingerprint: fingerprint(text, &input_files(&desc, dir)),
+            frame: 0,
             has_motion: camera.shutter.is_some() && any_velocity,
             camera,
             materials,
@@ -463,6 +498,8 @@ fn camera(c: &CameraDesc) -> Result<Camera, Failure> {
         focus_distance,
         focal_length,
         shutter,
+        time_offset: 0.0,
+        frame_rate: c.frame_rate.map_or(DEFAULT_FRAME_RATE, |r| r.0),
         velocity: c.velocity.map_or(DVec3::ZERO, v),
     })
 }
@@ -877,4 +914,40 @@ fn load_obj(path: &Path, limit: usize) -> Result<Vec<ObjTriangle>, String> {
         return Err("the file has no triangles".into());
     }
     Ok(out)
+}
+
+/// Frames per second of an animation when the scene does not say.
+pub const DEFAULT_FRAME_RATE: f64 = 24.0;
+/// Highest animation frame ([`World::at_frame`]): over an hour at 240 frames per second.
+pub const MAX_FRAME: u32 = 1_000_000;
+
+/// The files a scene reads besides itself (texture images, OBJ meshes), resolved against
+/// `dir`.
+fn input_files(desc: &SceneFile, dir: &Path) -> Vec<std::path::PathBuf> {
+    let textures = desc.textures.iter().filter_map(|(_, t)| match &t.value {
+        TextureDesc::Image { file, .. } => Some(dir.join(&file.value)),
+        _ => None,
+    });
+    let meshes = desc.shapes.iter().filter_map(|s| match s {
+        ShapeDesc::Mesh { obj, .. } => Some(dir.join(&obj.value)),
+        _ => None,
+    });
+    textures.chain(meshes).collect()
+}
+
+/// FNV-1a of `text` and of the bytes of `files` (a file that cannot be read adds its
+/// name): [`World::fingerprint`]. The files were read when the scene was built, within
+/// their size limits.
+fn fingerprint(text: &str, files: &[std::path::PathBuf]) -> u64 {
+    use std::hash::Hasher;
+    let mut h = fnv::FnvHasher::default();
+    h.write(text.as_bytes());
+    for f in files {
+        h.write(&[0xff]);
+        match std::fs::read(f) {
+            Ok(bytes) => h.write(&bytes),
+            Err(_) => h.write(f.display().to_string().as_bytes()),
+        }
+    }
+    h.finish()
 }
