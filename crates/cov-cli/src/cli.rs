@@ -61,6 +61,9 @@ enum Command {
     /// method): the covariance pass, samples where it predicts detail, per-pixel filters
     /// from Σ; writes the image (EXR and PNG) and the density and filter maps.
     Render(crate::render::RenderArgs),
+    /// Merge the parts of a render (`covtrace render --part I/N`) into its image: the
+    /// single-process render's, bit for bit; writes what `render` writes.
+    Merge(crate::render::MergeArgs),
     /// Image error against run time: every sampling and reconstruction method (uniform,
     /// Gaussian, variance-driven, covariance-driven) at several budgets against a cached
     /// reference; writes CSV/JSON, the error-time chart and an equal-time strip.
@@ -237,6 +240,7 @@ fn run(cli: Cli, registry: &Registry) -> Result<(), String> {
             say!("{}", cov_stiff::report(&outcomes).trim_end());
         }
         Command::Render(args) => say!("{}", crate::render::run(&args)?.trim_end()),
+        Command::Merge(args) => say!("{}", crate::render::merge(&args)?.trim_end()),
         Command::RenderBench(args) => say!("{}", crate::bench::bench(&args)?.trim_end()),
         Command::RenderCheck(args) => say!("{}", crate::render::check(&args)?.trim_end()),
         Command::List => {

@@ -8,6 +8,7 @@ use cov_render::covpass::MAX_COV_PATHS;
 use cov_render::denoise::Denoise;
 use cov_render::film::tile_count;
 use cov_render::output::{write_image, write_maps};
+use cov_render::parts::{Part, PartFilm};
 use cov_render::renderer::timed;
 use cov_render::{MAX_SPP, Method, RenderError, RenderSettings, Renderer, World};
 use indicatif::{ProgressBar, ProgressStyle};
@@ -50,7 +51,64 @@ pub struct RenderArgs {
     /// Render at this size instead of the scene's (`WIDTHxHEIGHT`, e.g. `640x480`).
     #[arg(long, value_parser = parse_size)]
     pub size: Option<(u32, u32)>,
+    /// Render only part I of N (`I/N`, e.g. `2/4`) and write it as a part file (EXR) for
+    /// `covtrace merge`: a job array renders the parts, one merge makes the image.
+    #[arg(long, value_parser = parse_part)]
+    pub part: Option<Part>,
+    /// Render frame K of an animation: the shutter moves by K / the scene's frame_rate.
+    #[arg(long, conflicts_with = "frames")]
+    pub frame: Option<u32>,
+    /// Render frames A to B (`A..B`, B included), each to OUT with its number before the
+    /// extension (`out.0007.exr`).
+    #[arg(long, value_parser = parse_frames)]
+    pub frames: Option<(u32, u32)>,
 }
+
+/// What `covtrace merge` was asked (parsed by clap).
+#[derive(Clone, Debug, clap::Args)]
+pub struct MergeArgs {
+    /// The part files (`covtrace render --part I/N -o PART.exr`), in any order.
+    #[arg(required = true)]
+    pub parts: Vec<PathBuf>,
+    /// Output EXR (linear); the PNG, the feature images and the covariance maps are
+    /// written beside it, as `render` writes them.
+    #[arg(short, long, default_value = "render.exr")]
+    pub output: PathBuf,
+}
+
+/// Parses `--part I/N`.
+///
+/// # Errors
+/// Not of that form.
+pub fn parse_part(s: &str) -> Result<Part, String> {
+    Part::parse(s)
+}
+
+/// Parses `--frames A..B` (`A ≤ B ≤ MAX_FRAME`, at most [`MAX_FRAMES`] frames).
+///
+/// # Errors
+/// Not of that form, or out of range.
+pub fn parse_frames(s: &str) -> Result<(u32, u32), String> {
+    let max = cov_render::world::MAX_FRAME;
+    let bad = || {
+        format!(
+            "--frames must be A..B with 0 ≤ A ≤ B ≤ {max} and at most {MAX_FRAMES} frames, got `{}`",
+            cov_render::echo(s)
+        )
+    };
+    let (a, b) = s.split_once("..").ok_or_else(bad)?;
+    let (a, b) = (
+        a.trim().parse::<u32>().map_err(|_| bad())?,
+        b.trim().parse::<u32>().map_err(|_| bad())?,
+    );
+    if a > b || b > max || b - a >= MAX_FRAMES {
+        return Err(bad());
+    }
+    Ok((a, b))
+}
+
+/// Most frames one `covtrace render --frames A..B` renders.
+pub const MAX_FRAMES: u32 = 100_000;
 
 /// Parses a denoiser name: `none`, `oidn` or `oidn-color`.
 ///
@@ -222,16 +280,57 @@ pub fn load(scene: &Path, size: Option<(u32, u32)>) -> Result<World, String> {
 pub fn run(a: &RenderArgs) -> Result<String, String> {
     let settings = settings(a)?;
     check_output(&a.output, "exr")?;
+    if a.part.is_some() && a.time.is_some() {
+        return Err("--part and --time exclude each other: a part renders a fixed budget".into());
+    }
     let world = load(&a.scene, a.size)?;
+    let (h, part) = (world.camera.height, a.part);
+    if let Some(p) = part {
+        p.rows(h).map_err(|e| format!("--{e}"))?;
+    }
+    match (a.frame, a.frames) {
+        (_, Some((first, last))) => {
+            let mut world = world;
+            let mut out = String::new();
+            for k in first..=last {
+                // One scene, retimed for each frame.
+                world = world.at_frame(k).map_err(|e| e.to_string())?;
+                out.push_str(&format!("frame {k}:\n"));
+                out.push_str(&render_one(a, &settings, &world, &frame_path(&a.output, k))?);
+            }
+            Ok(out)
+        }
+        (k, None) => {
+            let world = world.at_frame(k.unwrap_or(0)).map_err(|e| e.to_string())?;
+            render_one(a, &settings, &world, &a.output)
+        }
+    }
+}
+
+/// `out.exr` with frame `k`'s number before the extension: `out.0007.exr`.
+pub fn frame_path(out: &Path, k: u32) -> PathBuf {
+    out.with_extension(format!("{k:04}.exr"))
+}
+
+/// Renders one frame (or one part of it) of `world` to `output`.
+fn render_one(
+    a: &RenderArgs,
+    settings: &RenderSettings,
+    world: &World,
+    output: &Path,
+) -> Result<String, String> {
+    if let Some(p) = a.part {
+        return render_part(a, settings, world, p, output);
+    }
     let (w, h) = (world.camera.width, world.camera.height);
-    let [png, density, filter, json, aov] = outputs(&a.output);
+    let [png, density, filter, json, aov] = outputs(output);
     let mut out = format!(
         "scene: {} ({w}×{h} px, {} primitives, {} lights)\n",
         cov_render::echo(&a.scene.display().to_string()),
         world.geometry.len(),
         world.lights.len(),
     );
-    let mut renderer = Renderer::new(&world, settings).map_err(|e| e.to_string())?;
+    let mut renderer = Renderer::new(world, settings.clone()).map_err(|e| e.to_string())?;
     let (b, start) = match a.time {
         None => (bar(renderer.progress_len(), "rendering"), None),
         Some(t) => (seconds_bar(t), Some(std::time::Instant::now())),
@@ -243,7 +342,7 @@ pub fn run(a: &RenderArgs) -> Result<String, String> {
     let r = renderer.render(Some(&tick)).map_err(|e| e.to_string());
     b.finish_and_clear();
     let r = r?;
-    write_image(&r.image, &a.output, &png).map_err(|e| e.to_string())?;
+    write_image(&r.image, output, &png).map_err(|e| e.to_string())?;
     cov_render::output::write_aovs(&r.film.aovs(), &aov).map_err(|e| e.to_string())?;
     let total = r.timing.total();
     if let Some(maps) = renderer.maps() {
@@ -270,6 +369,7 @@ pub fn run(a: &RenderArgs) -> Result<String, String> {
             r.samples as f64 / n
         ),
     };
+    out.push_str(&format!("image digest: {:016x}\n", r.image.digest()));
     out.push_str(&format!(
         "render: {}, {} samples ({:.1} spp on average) in {total:.2} s (sampling {:.2} s, reconstruction {:.2} s{}){reached}\n",
         r.method.with_denoiser(a.denoise),
@@ -283,11 +383,117 @@ pub fn run(a: &RenderArgs) -> Result<String, String> {
             format!(", denoising {:.2} s", r.timing.denoising)
         },
     ));
-    let mut written = vec![a.output.clone(), png, aov];
+    let mut written = vec![output.to_path_buf(), png, aov];
     if renderer.maps().is_some() {
         written.extend([density, filter, json]);
     }
     out.push_str("wrote:\n");
+    for f in written {
+        out.push_str(&format!("  {}\n", cov_render::echo(&f.display().to_string())));
+    }
+    Ok(out)
+}
+
+/// Renders part `part` of `world` and writes it to `output` (a part file).
+fn render_part(
+    a: &RenderArgs,
+    settings: &RenderSettings,
+    world: &World,
+    part: Part,
+    output: &Path,
+) -> Result<String, String> {
+    let mut renderer = Renderer::new(world, settings.clone()).map_err(|e| e.to_string())?;
+    let b = bar(
+        renderer.part_progress_len(part).map_err(|e| e.to_string())?,
+        "rendering",
+    );
+    let p = renderer.render_part(part, Some(&|| b.inc(1)));
+    b.finish_and_clear();
+    let p = p.map_err(|e| e.to_string())?;
+    p.write(output).map_err(|e| e.to_string())?;
+    let n = f64::from(world.camera.width) * f64::from(p.rows.end - p.rows.start);
+    Ok(format!(
+        "scene: {} ({}×{} px), frame {}\npart {part}: rows {}..{}, {} samples ({:.1} spp on average) in {:.2} s (covariance {:.2} s, sampling {:.2} s, allocation {:.2} s)\nwrote:\n  {}\n",
+        cov_render::echo(&a.scene.display().to_string()),
+        world.camera.width,
+        world.camera.height,
+        world.frame,
+        p.rows.start,
+        p.rows.end,
+        p.samples(),
+        p.samples() as f64 / n.max(1.0),
+        p.timing.total(),
+        p.timing.covariance,
+        p.timing.sampling,
+        p.timing.allocation,
+        cov_render::echo(&output.display().to_string()),
+    ))
+}
+
+/// Runs `covtrace merge`; returns the lines to print.
+///
+/// # Errors
+/// A part file that cannot be read or is not a part; parts that do not make one render;
+/// unwritable outputs.
+pub fn merge(a: &MergeArgs) -> Result<String, String> {
+    check_output(&a.output, "exr")?;
+    let max = cov_render::parts::MAX_PARTS as usize;
+    if a.parts.len() > max {
+        return Err(format!(
+            "{} part files given; a render has at most {max} parts",
+            a.parts.len()
+        ));
+    }
+    let parts = a
+        .parts
+        .iter()
+        .map(|p| PartFilm::read(p).map_err(|e| e.to_string()))
+        .collect::<Result<Vec<_>, _>>()?;
+    let m = cov_render::parts::merge(&parts).map_err(|e| e.to_string())?;
+    let [png, density, filter, json, aov] = outputs(&a.output);
+    write_image(&m.image, &a.output, &png).map_err(|e| e.to_string())?;
+    cov_render::output::write_aovs(&m.film.aovs(), &aov).map_err(|e| e.to_string())?;
+    let mut written = vec![a.output.clone(), png, aov];
+    if let Some(maps) = &m.maps {
+        let sp = covtrace::sensor::SensorParams::default();
+        write_maps(maps, sp.filter, sp.max_filter, &density, &filter, &json).map_err(|e| e.to_string())?;
+        written.extend([density, filter, json]);
+    }
+    let k = &m.key;
+    let mut out = format!(
+        "render: {}×{} px, frame {}, {} at {} spp, seed {}, in {} parts\n",
+        k.width,
+        k.height,
+        k.frame,
+        m.method
+            .with_denoiser(cov_render::denoise::Denoise::from_name(&k.denoise).unwrap_or_default()),
+        k.spp,
+        k.seed,
+        k.parts
+    );
+    let mut sorted: Vec<&PartFilm> = parts.iter().collect();
+    sorted.sort_by_key(|p| p.part.index);
+    for p in sorted {
+        out.push_str(&format!(
+            "  part {}: rows {}..{}, {} samples in {:.2} s ({})\n",
+            p.part,
+            p.rows.start,
+            p.rows.end,
+            p.samples(),
+            p.timing.total(),
+            p.source
+        ));
+    }
+    out.push_str(&format!("image digest: {:016x}\n", m.image.digest()));
+    out.push_str(&format!(
+        "merge: reconstruction {:.2} s{}\nwrote:\n",
+        m.timing.reconstruction,
+        if m.timing.denoising > 0.0 {
+            format!(", denoising {:.2} s", m.timing.denoising)
+        } else {
+            String::new()
+        }
+    ));
     for f in written {
         out.push_str(&format!("  {}\n", cov_render::echo(&f.display().to_string())));
     }

@@ -58,6 +58,23 @@ impl Image {
     pub fn get(&self, x: u32, y: u32) -> DVec3 {
         self.pixels[y as usize * self.width as usize + x as usize]
     }
+
+    /// A digest of the image's exact values: FNV-1a (64 bits) of its size and of every
+    /// pixel's `f64` bits. Two images with one digest are, in practice, the same bits
+    /// (`covtrace render` and `covtrace merge` print it; their EXR files, compressed in
+    /// parallel, may order their bytes differently).
+    pub fn digest(&self) -> u64 {
+        use std::hash::Hasher;
+        let mut h = fnv::FnvHasher::default();
+        h.write_u32(self.width);
+        h.write_u32(self.height);
+        for p in &self.pixels {
+            for v in p.to_array() {
+                h.write_u64(v.to_bits());
+            }
+        }
+        h.finish()
+    }
 }
 
 /// The tiles of a `width × height` image: (x0, y0, x1, y1), row by row.

@@ -52,6 +52,8 @@ use crate::{RenderError, World};
 pub const PILOT_MARGIN: u32 = 2 * TILE;
 /// Rows of the covariance pass a part traces on each side of its own rows (module docs).
 pub const GUIDE_MARGIN: u32 = 3 * TILE;
+/// Most parts a render splits into: the bands of the largest image.
+pub const MAX_PARTS: u32 = crate::scene::MAX_RESOLUTION / ALLOC_BAND;
 /// Version of the part file's layout and key.
 pub const FORMAT: u32 = 1;
 /// Most channels a part file may hold (the film's 32 and the maps' 10 fit).
