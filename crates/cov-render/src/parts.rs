@@ -518,12 +518,7 @@ impl PartFilm {
             image
                 .layer_data
                 .iter()
-                .find(|l| {
-                    l.attributes
-                        .layer_name
-                        .as_ref()
-                        .is_some_and(|n| n.to_string() == name)
-                })
+                .find(|l| l.attributes.layer_name.as_ref().is_some_and(|n| n == name))
                 .ok_or_else(|| bad(format!("no `{name}` layer")))
         };
         let u32s =
@@ -668,7 +663,7 @@ pub fn merge(parts: &[PartFilm]) -> Result<Merged, RenderError> {
         }
     }
     let mut timing = Timing::default();
-    let maps = method.uses_covariance().then(|| CovMaps {
+    let maps = method.uses_covariance().then_some(CovMaps {
         width: w,
         height: h,
         pixels,
@@ -704,14 +699,14 @@ mod tests {
     fn margins_cover_what_the_allocation_reads() {
         let splat = (CUTOFF * MAX_FILTER).ceil() as u32 + 1;
         let edge = (EDGE_REACH * MAX_FILTER).ceil() as u32 + 1;
-        assert!(PILOT_MARGIN >= splat + 2 && PILOT_MARGIN % TILE == 0);
-        assert!(GUIDE_MARGIN >= PILOT_MARGIN + edge && GUIDE_MARGIN % TILE == 0);
-        assert_eq!(ALLOC_BAND % TILE, 0);
+        assert!(PILOT_MARGIN >= splat + 2 && PILOT_MARGIN.is_multiple_of(TILE));
+        assert!(GUIDE_MARGIN >= PILOT_MARGIN + edge && GUIDE_MARGIN.is_multiple_of(TILE));
+        assert!(ALLOC_BAND.is_multiple_of(TILE));
     }
 
     #[test]
     fn parts_cover_every_row_once() {
-        for h in [1, 31, 32, 33, 96, 100, 192, 1080] {
+        for h in [1u32, 31, 32, 33, 96, 100, 192, 1080] {
             let bands = h.div_ceil(ALLOC_BAND);
             for n in 1..=bands.min(9) {
                 let mut next = 0;

@@ -344,7 +344,12 @@ impl<'w> Renderer<'w> {
     /// The covariance pass's errors ([`Renderer::trace_covariance`]).
     pub fn render(&mut self, progress: Progress<'_>) -> Result<Rendered, RenderError> {
         let win = Window::whole(self.world.camera.height);
-        let (film, mut timing, passes, cands) = self.sample(&win, progress)?;
+        let Sampled {
+            film,
+            mut timing,
+            passes,
+            cands,
+        } = self.sample(&win, progress)?;
         let method = self.settings.method;
         let guide = self.guide.as_ref().filter(|_| method.uses_covariance());
         let image = reconstruct(method, guide, &cands, &film, self.settings.denoise, &mut timing)?;
@@ -375,7 +380,7 @@ impl<'w> Renderer<'w> {
             ));
         }
         let win = part.window(self.world.camera.height)?;
-        let (film, timing, _, _) = self.sample(&win, progress)?;
+        let Sampled { film, timing, .. } = self.sample(&win, progress)?;
         Ok(PartFilm::new(
             self.world,
             &self.settings,
@@ -450,11 +455,7 @@ impl<'w> Renderer<'w> {
 
     /// The samples of `win`'s rows: the covariance pass when the method needs it, the
     /// pilot and the passes; the film, the timing, the passes and the guard's candidates.
-    fn sample(
-        &mut self,
-        win: &Window,
-        progress: Progress<'_>,
-    ) -> Result<(Film, Timing, u32, Vec<Vec<Gaussian>>), RenderError> {
+    fn sample(&mut self, win: &Window, progress: Progress<'_>) -> Result<Sampled, RenderError> {
         let start = Instant::now();
         let method = self.settings.method;
         if method.uses_covariance() && !self.guide_given {
@@ -577,8 +578,22 @@ impl<'w> Renderer<'w> {
                 passes += 1;
             }
         }
-        Ok((film, timing, passes, cands))
+        Ok(Sampled {
+            film,
+            timing,
+            passes,
+            cands,
+        })
     }
+}
+
+/// What [`Renderer::sample`] gives: the film, the timing, the passes and the guard's
+/// candidate filters (empty for the other methods).
+struct Sampled {
+    film: Film,
+    timing: Timing,
+    passes: u32,
+    cands: Vec<Vec<Gaussian>>,
 }
 
 /// Rows of the image whose pixels share one allocation of samples: each band of

@@ -924,7 +924,7 @@ pub const MAX_FRAME: u32 = 1_000_000;
 /// The files a scene reads besides itself (texture images, OBJ meshes), resolved against
 /// `dir`.
 fn input_files(desc: &SceneFile, dir: &Path) -> Vec<std::path::PathBuf> {
-    let textures = desc.textures.iter().filter_map(|(_, t)| match &t.value {
+    let textures = desc.textures.values().filter_map(|t| match &t.value {
         TextureDesc::Image { file, .. } => Some(dir.join(&file.value)),
         _ => None,
     });

@@ -1,0 +1,145 @@
+//! `covtrace render --part I/N` and `covtrace merge`: the merged image is the single
+//! render's (the digests both print), and bad parts get one line and exit code 2;
+//! `--frames A..B` writes one file per frame.
+
+use std::path::PathBuf;
+
+mod common;
+use common::covtrace;
+
+fn tmp(name: &str) -> PathBuf {
+    common::tmp("parts", name)
+}
+
+fn s(p: &std::path::Path) -> &str {
+    p.to_str().expect("utf-8 path")
+}
+
+/// The `image digest:` line of a run's output.
+fn digest(out: &std::process::Output) -> String {
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        out.status.success(),
+        "{text}{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    text.lines()
+        .find_map(|l| l.strip_prefix("image digest: "))
+        .unwrap_or_else(|| panic!("no digest in {text}"))
+        .to_string()
+}
+
+const SCENE: &str = "examples/scenes/chess.ron";
+const OPTS: [&str; 6] = ["--size", "40x96", "--spp", "4", "--seed", "2"];
+
+#[test]
+fn merged_parts_are_the_single_render() {
+    let single = tmp("single.exr");
+    let mut args = vec!["render", SCENE, "-o", s(&single)];
+    args.extend(OPTS);
+    let want = digest(&covtrace(&args));
+    let parts: Vec<PathBuf> = (1..=3).map(|i| tmp(&format!("part{i}.exr"))).collect();
+    // In reverse order: the parts do not depend on one another.
+    for (i, p) in parts.iter().enumerate().rev() {
+        let part = format!("{}/3", i + 1);
+        let mut args = vec!["render", SCENE, "--part", &part, "-o", s(p)];
+        args.extend(OPTS);
+        let out = covtrace(&args);
+        let text = String::from_utf8_lossy(&out.stdout);
+        assert!(
+            out.status.success() && text.contains(&format!("part {part}: rows")),
+            "{text}"
+        );
+    }
+    let merged = tmp("merged.exr");
+    let mut args = vec!["merge", "-o", s(&merged)];
+    args.extend(parts.iter().map(|p| s(p)));
+    let out = covtrace(&args);
+    assert_eq!(digest(&out), want);
+    for f in cov_cli::render::outputs(&merged).iter().chain([&merged]) {
+        assert!(f.exists(), "{} missing", f.display());
+    }
+    // A part missing, given twice, or from another render: one line, exit code 2.
+    let other = tmp("other2.exr");
+    let mut args = vec![
+        "render",
+        SCENE,
+        "--part",
+        "2/3",
+        "-o",
+        s(&other),
+        "--size",
+        "40x96",
+        "--spp",
+        "8",
+    ];
+    args.extend(["--seed", "2"]);
+    assert!(covtrace(&args).status.success());
+    for (files, want) in [
+        (vec![&parts[0], &parts[2]], "part 2/3 (rows 32..64) is missing"),
+        (
+            vec![&parts[0], &parts[1], &parts[1], &parts[2]],
+            "part 2/3 is given twice",
+        ),
+        (vec![&parts[0], &other, &parts[2]], "`spp` is 8.0 against 4.0"),
+        (vec![&single], "not a covtrace part file"),
+    ] {
+        let mut args = vec!["merge", "-o", s(&merged)];
+        args.extend(files.iter().map(|p| s(p)));
+        let out = covtrace(&args);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{err}");
+        assert!(err.contains(want) && err.trim_end().lines().count() == 1, "{err}");
+    }
+}
+
+#[test]
+fn bad_part_options_get_one_line() {
+    let out_file = tmp("bad.exr");
+    for (args, want) in [
+        (vec!["--part", "0/2"], "--part must be I/N"),
+        (vec!["--part", "3/4", "--size", "40x64"], "N ≤ 2"),
+        (
+            vec!["--part", "1/2", "--time", "1"],
+            "--part and --time exclude each other",
+        ),
+        (vec!["--frames", "3..1"], "--frames must be A..B"),
+        (vec!["--frame", "2000000"], "frame must be 0 to 1000000"),
+    ] {
+        let mut a = vec!["render", SCENE, "-o", s(&out_file)];
+        a.extend(args);
+        let out = covtrace(&a);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{err}");
+        assert!(err.contains(want) && err.trim_end().lines().count() == 1, "{err}");
+    }
+}
+
+#[test]
+fn frames_write_one_file_each_and_differ() {
+    let out_file = tmp("anim.exr");
+    let out = covtrace(&[
+        "render",
+        SCENE,
+        "--frames",
+        "0..1",
+        "--size",
+        "24x16",
+        "--spp",
+        "2",
+        "-o",
+        s(&out_file),
+    ]);
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(out.status.success(), "{text}");
+    let digests: Vec<&str> = text
+        .lines()
+        .filter_map(|l| l.strip_prefix("image digest: "))
+        .collect();
+    assert_eq!(digests.len(), 2, "{text}");
+    assert_ne!(digests[0], digests[1], "the moving piece moved between frames");
+    for k in 0..2 {
+        let f = cov_cli::render::frame_path(&out_file, k);
+        assert!(f.exists(), "{} missing", f.display());
+    }
+}
