@@ -141,7 +141,7 @@ fn ring(x: i64, y: i64, rho: i64) -> impl Iterator<Item = (i64, i64)> {
 /// pixel whose filter is narrower than the distance to it over [`EDGE_REACH`]: a wide
 /// filter stops short of an edge the covariance pass saw a few pixels away.
 ///
-/// Only the pixels of `rows` are narrowed (a part of a render, [`crate::parts`]); the
+/// Only the pixels of `rows` are narrowed (a part of a render, the `parts` module); the
 /// others keep their raw filter.
 pub fn edge_clamp(width: u32, height: u32, raw: &[Gaussian], rows: Range<u32>) -> Vec<Gaussian> {
     use rayon::prelude::*;

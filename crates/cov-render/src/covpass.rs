@@ -571,7 +571,7 @@ pub fn covariance_maps(
 }
 
 /// [`covariance_maps`] of the tiles whose first row lies in `rows` (a part of a render,
-/// [`crate::parts`]); the other pixels keep [`PixelCov::default`]. Each tile draws from
+/// the `parts` module); the other pixels keep [`PixelCov::default`]. Each tile draws from
 /// its own generator, seeded by its index in the whole image, so a tile's values are the
 /// same whichever rows are traced.
 ///

@@ -56,7 +56,7 @@ pub enum RenderError {
         /// Second height.
         b_h: u32,
     },
-    /// Parts of a render that do not make one render ([`crate::parts::merge`]).
+    /// Parts of a render that do not make one render (`parts::merge`).
     #[error("{0}")]
     Parts(String),
     /// The denoiser is not in this build, or failed.

@@ -464,7 +464,7 @@ impl Film {
     }
 
     /// [`Film::render`] of the tiles whose first row lies in `rows` (a part of a render,
-    /// [`crate::parts`]); `progress` is called once per such tile.
+    /// the `parts` module); `progress` is called once per such tile.
     pub fn render_rows(
         &mut self,
         world: &World,

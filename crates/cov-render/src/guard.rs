@@ -89,7 +89,7 @@ pub fn candidate(guide: &Guide, scale: f64, rows: Range<u32>) -> Vec<Gaussian> {
 /// reading: a pilot's noise must not hide detail the full budget will show).
 ///
 /// `candidates` are [`candidates`] of the film's guide. Only the pixels of `rows` are
-/// estimated and chosen (a part of a render, [`crate::parts`]); the others take the box.
+/// estimated and chosen (a part of a render, the `parts` module); the others take the box.
 pub fn guarded(candidates: &[Vec<Gaussian>], film: &Film, target: f64, rows: Range<u32>) -> Guarded {
     let (w, h) = (film.width as i64, film.height as i64);
     let inside = |p: usize| rows.contains(&((p as i64 / w.max(1)) as u32));

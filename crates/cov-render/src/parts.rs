@@ -8,16 +8,20 @@
 //!
 //! **What a part computes.** Everything its own pixels' samples depend on, and nothing
 //! else ([`Renderer::render_part`](crate::Renderer::render_part)):
-//! - the covariance pass over its rows and [`GUIDE_MARGIN`] rows on each side;
-//! - the pilot over its rows and [`PILOT_MARGIN`] rows on each side;
+//! - the covariance pass over its rows and [`GUIDE_MARGIN`](crate::renderer::GUIDE_MARGIN)
+//!   rows on each side;
+//! - the pilot over its rows and [`PILOT_MARGIN`](crate::renderer::PILOT_MARGIN) rows on
+//!   each side;
 //! - the allocation of its bands, and the rest of their samples.
 //!
 //! The margins are as deep as the allocation reads. A pixel's share follows the guard's
 //! choice, which averages the candidates' error estimates over 3×3 pixels. Each estimate
-//! reads the pilot's samples within [`CUTOFF`] standard deviations of the widest filter
-//! ([`MAX_FILTER`] px), and their 3×3 mean luminance: 2 + 24 rows, rounded up to whole
-//! tiles (32). The candidates of those rows are kept off the edges that the pass saw up to
-//! [`EDGE_REACH`] × [`MAX_FILTER`] = 16 rows further: 42 rows of covariance, 48 in tiles.
+//! reads the pilot's samples within [`CUTOFF`](crate::film::CUTOFF) standard deviations
+//! of the widest filter ([`MAX_FILTER`](crate::adaptive::MAX_FILTER) px), and their 3×3
+//! mean luminance: 1 + 24 rows, rounded up to whole tiles (32). The filters of those rows
+//! are kept off the edges that the pass saw up to
+//! [`EDGE_REACH`](crate::adaptive::EDGE_REACH) × `MAX_FILTER` = 16 rows further: 41 rows
+//! of covariance, 48 in tiles.
 //! Tiles of the pass and pixels of the film draw their random numbers from generators
 //! seeded by their place in the whole image, and every sum is added in the same order, so
 //! a part's pixels are bit for bit the single render's.
@@ -43,15 +47,14 @@ use serde::{Deserialize, Serialize};
 use crate::adaptive::Guide;
 use crate::covpass::{CovMaps, PixelCov};
 use crate::denoise::Denoise;
-use crate::film::{Film, Image, TILE};
+use crate::film::Progress;
+use crate::film::{Film, Image};
 use crate::guard::candidates;
-use crate::renderer::{ALLOC_BAND, Method, RenderSettings, Timing, reconstruct, timed};
+use crate::renderer::{
+    ALLOC_BAND, Method, RenderSettings, Renderer, Sampled, Timing, Window, reconstruct, timed,
+};
 use crate::{RenderError, World};
 
-/// Rows of pilot samples a part takes on each side of its own rows (module docs).
-pub const PILOT_MARGIN: u32 = 2 * TILE;
-/// Rows of the covariance pass a part traces on each side of its own rows (module docs).
-pub const GUIDE_MARGIN: u32 = 3 * TILE;
 /// Most parts a render splits into: the bands of the largest image.
 pub const MAX_PARTS: u32 = crate::scene::MAX_RESOLUTION / ALLOC_BAND;
 /// Version of the part file's layout and key.
@@ -119,36 +122,42 @@ impl std::fmt::Display for Part {
     }
 }
 
-/// The rows a render computes at each stage: its own, the pilot's and the covariance
-/// pass's (module docs).
-#[derive(Clone, Debug, PartialEq, Eq)]
-pub(crate) struct Window {
-    /// The rows whose samples the render keeps.
-    pub owned: Range<u32>,
-    /// The rows of the pilot.
-    pub pilot: Range<u32>,
-    /// The rows of the covariance pass.
-    pub guide: Range<u32>,
-}
-
-impl Window {
-    /// The whole image.
-    pub fn whole(height: u32) -> Window {
-        Window {
-            owned: 0..height,
-            pilot: 0..height,
-            guide: 0..height,
+impl Renderer<'_> {
+    /// Renders one part of the image ([module docs](self)): the rows `part` owns, with the
+    /// covariance pass and the pilot over the margins their filters need. The image is not
+    /// reconstructed: [`merge`] does that from all the parts.
+    ///
+    /// # Errors
+    /// More parts than the image has allocation bands; a time limit (a part renders a fixed
+    /// budget); the covariance pass's errors.
+    pub fn render_part(&mut self, part: Part, progress: Progress<'_>) -> Result<PartFilm, RenderError> {
+        if self.settings().time.is_some() {
+            return Err(RenderError::setting(
+                "time",
+                "left out when rendering a part (a part renders a fixed budget)",
+                self.settings().time.unwrap_or_default(),
+            ));
         }
+        let win = part.window(self.world.camera.height)?;
+        let Sampled { film, timing, .. } = self.sample(&win, progress)?;
+        Ok(PartFilm::new(
+            self.world,
+            self.settings(),
+            part,
+            &win,
+            &film,
+            self.maps(),
+            timing,
+        ))
     }
 
-    /// `owned` and its margins, clipped to the image.
-    pub fn around(owned: Range<u32>, height: u32) -> Window {
-        let grow = |m: u32| owned.start.saturating_sub(m)..(owned.end.saturating_add(m)).min(height);
-        Window {
-            pilot: grow(PILOT_MARGIN),
-            guide: grow(GUIDE_MARGIN),
-            owned,
-        }
+    /// How many times [`Renderer::render_part`] calls its progress callback.
+    ///
+    /// # Errors
+    /// As [`Part::rows`].
+    pub fn part_progress_len(&self, part: Part) -> Result<usize, RenderError> {
+        let win = part.window(self.world.camera.height)?;
+        Ok(self.window_progress_len(&win))
     }
 }
 
@@ -692,15 +701,20 @@ pub fn merge(parts: &[PartFilm]) -> Result<Merged, RenderError> {
 mod tests {
     use super::*;
     use crate::adaptive::{EDGE_REACH, MAX_FILTER};
-    use crate::film::CUTOFF;
+    use crate::film::{CUTOFF, TILE};
+    use crate::renderer::{GUIDE_MARGIN, PILOT_MARGIN};
 
-    /// The margins are as deep as the allocation reads (module docs), in whole tiles.
+    /// The margins are as deep as the allocation reads (module docs), in whole tiles: the
+    /// guard's choice at an owned row reads the error estimates one row away, which read
+    /// the samples of sources within a filter's reach (and the 3×3 mean luminance), whose
+    /// filters read the covariance within the edge clamp's reach. One row of slack on each
+    /// reach for rounding.
     #[test]
     fn margins_cover_what_the_allocation_reads() {
         let splat = (CUTOFF * MAX_FILTER).ceil() as u32 + 1;
         let edge = (EDGE_REACH * MAX_FILTER).ceil() as u32 + 1;
-        assert!(PILOT_MARGIN >= splat + 2 && PILOT_MARGIN.is_multiple_of(TILE));
-        assert!(GUIDE_MARGIN >= PILOT_MARGIN + edge && GUIDE_MARGIN.is_multiple_of(TILE));
+        assert!(PILOT_MARGIN >= (1 + splat).max(2) && PILOT_MARGIN.is_multiple_of(TILE));
+        assert!(GUIDE_MARGIN >= 1 + splat + edge && GUIDE_MARGIN.is_multiple_of(TILE));
         assert!(ALLOC_BAND.is_multiple_of(TILE));
     }
 

@@ -45,7 +45,6 @@ use crate::covpass::{CovMaps, MAX_COV_PATHS, STRIDES, covariance_rows};
 use crate::denoise::Denoise;
 use crate::film::{Film, Filter, Gaussian, Image, MAX_SPP, Progress};
 use crate::guard::{candidate, candidates, guarded};
-use crate::parts::{Part, PartFilm, Window};
 use crate::world::World;
 
 /// Std of the fixed Gaussian filter of the `gauss` baseline (px).
@@ -252,7 +251,7 @@ pub struct Rendered {
 /// Renders a world with one method: see the module docs.
 #[derive(Debug)]
 pub struct Renderer<'w> {
-    world: &'w World,
+    pub(crate) world: &'w World,
     settings: RenderSettings,
     maps: Option<CovMaps>,
     /// The rows `maps` were traced over.
@@ -364,45 +363,8 @@ impl<'w> Renderer<'w> {
         })
     }
 
-    /// Renders one part of the image ([`crate::parts`]): the rows `part` owns, with the
-    /// covariance pass and the pilot over the margins their filters need. The image is not
-    /// reconstructed: [`crate::parts::merge`] does that from all the parts.
-    ///
-    /// # Errors
-    /// More parts than the image has allocation bands; a time limit (a part renders a fixed
-    /// budget); the covariance pass's errors.
-    pub fn render_part(&mut self, part: Part, progress: Progress<'_>) -> Result<PartFilm, RenderError> {
-        if self.settings.time.is_some() {
-            return Err(RenderError::setting(
-                "time",
-                "left out when rendering a part (a part renders a fixed budget)",
-                self.settings.time.unwrap_or_default(),
-            ));
-        }
-        let win = part.window(self.world.camera.height)?;
-        let Sampled { film, timing, .. } = self.sample(&win, progress)?;
-        Ok(PartFilm::new(
-            self.world,
-            &self.settings,
-            part,
-            &win,
-            &film,
-            self.maps.as_ref(),
-            timing,
-        ))
-    }
-
-    /// How many times [`Renderer::render_part`] calls its progress callback.
-    ///
-    /// # Errors
-    /// As [`Part::window`].
-    pub fn part_progress_len(&self, part: Part) -> Result<usize, RenderError> {
-        let win = part.window(self.world.camera.height)?;
-        Ok(self.window_progress_len(&win))
-    }
-
     /// Progress calls of a render of `win`: one per tile of each stage.
-    fn window_progress_len(&self, win: &Window) -> usize {
+    pub(crate) fn window_progress_len(&self, win: &Window) -> usize {
         let (w, s) = (self.world.camera.width, &self.settings);
         let tiles = |r: &Range<u32>| {
             crate::film::tiles(w, self.world.camera.height)
@@ -455,7 +417,7 @@ impl<'w> Renderer<'w> {
 
     /// The samples of `win`'s rows: the covariance pass when the method needs it, the
     /// pilot and the passes; the film, the timing, the passes and the guard's candidates.
-    fn sample(&mut self, win: &Window, progress: Progress<'_>) -> Result<Sampled, RenderError> {
+    pub(crate) fn sample(&mut self, win: &Window, progress: Progress<'_>) -> Result<Sampled, RenderError> {
         let start = Instant::now();
         let method = self.settings.method;
         if method.uses_covariance() && !self.guide_given {
@@ -589,20 +551,63 @@ impl<'w> Renderer<'w> {
 
 /// What [`Renderer::sample`] gives: the film, the timing, the passes and the guard's
 /// candidate filters (empty for the other methods).
-struct Sampled {
-    film: Film,
-    timing: Timing,
-    passes: u32,
-    cands: Vec<Vec<Gaussian>>,
+pub(crate) struct Sampled {
+    pub film: Film,
+    pub timing: Timing,
+    pub passes: u32,
+    pub cands: Vec<Vec<Gaussian>>,
 }
 
 /// Rows of the image whose pixels share one allocation of samples: each band of
 /// `ALLOC_BAND` rows (the last one shorter) spends its own pixels' share of the budget,
-/// distributed by the method's weights. A render split into parts ([`crate::parts`]) gives
-/// each part whole bands, so that the parts' allocations are the single render's. Two
+/// distributed by the method's weights. A render split into parts (the `parts` module)
+/// gives each part whole bands, so that the parts' allocations are the single render's. Two
 /// tiles, so that an image of a few hundred rows still splits into several parts, while a
 /// band (two tiles by the image's width) still holds both flat regions and detail.
 pub const ALLOC_BAND: u32 = 2 * crate::film::TILE;
+
+/// Rows of pilot samples a part of a render takes on each side of its own rows: the
+/// guard's choice at an owned row reads error estimates one row away, which read the
+/// samples within the widest filter's reach (`CUTOFF` × [`crate::adaptive::MAX_FILTER`] =
+/// 24 rows) and their 3×3 mean luminance; 25 rows, in whole tiles.
+pub const PILOT_MARGIN: u32 = 2 * crate::film::TILE;
+/// Rows of the covariance pass a part of a render traces on each side of its own rows:
+/// the filters of the pilot's rows that matter are kept off the edges the pass saw up to
+/// `EDGE_REACH` × `MAX_FILTER` = 16 rows further; 41 rows, in whole tiles.
+pub const GUIDE_MARGIN: u32 = 3 * crate::film::TILE;
+
+/// The rows a render computes at each stage: its own, the pilot's and the covariance
+/// pass's.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub(crate) struct Window {
+    /// The rows whose samples the render keeps.
+    pub owned: Range<u32>,
+    /// The rows of the pilot.
+    pub pilot: Range<u32>,
+    /// The rows of the covariance pass.
+    pub guide: Range<u32>,
+}
+
+impl Window {
+    /// The whole image.
+    pub fn whole(height: u32) -> Window {
+        Window {
+            owned: 0..height,
+            pilot: 0..height,
+            guide: 0..height,
+        }
+    }
+
+    /// `owned` and its margins ([`PILOT_MARGIN`], [`GUIDE_MARGIN`]), clipped to the image.
+    pub fn around(owned: Range<u32>, height: u32) -> Window {
+        let grow = |m: u32| owned.start.saturating_sub(m)..(owned.end.saturating_add(m)).min(height);
+        Window {
+            pilot: grow(PILOT_MARGIN),
+            guide: grow(GUIDE_MARGIN),
+            owned,
+        }
+    }
+}
 
 /// Samples per pixel ∝ `weights` between `floors` and `hi` ([`allocate_floors`]), each band
 /// of [`ALLOC_BAND`] rows of `owned` spending `spp` times its pixels; 0 outside `owned`.

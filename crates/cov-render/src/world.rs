@@ -277,7 +277,7 @@ pub struct World {
     /// The file it came from.
     pub file: String,
     /// A hash (FNV-1a, 64 bits) of the scene's text and of every file it reads (textures,
-    /// OBJ meshes): what tells renders of different scenes apart ([`crate::parts`]).
+    /// OBJ meshes): what tells renders of different scenes apart (the `parts` module).
     pub fingerprint: u64,
     /// The animation frame the camera and the objects are at ([`World::at_frame`]).
     pub frame: u32,
