@@ -371,11 +371,12 @@ fn render_one(
     };
     out.push_str(&format!("image digest: {:016x}\n", r.image.digest()));
     out.push_str(&format!(
-        "render: {}, {} samples ({:.1} spp on average) in {total:.2} s (sampling {:.2} s, reconstruction {:.2} s{}){reached}\n",
+        "render: {}, {} samples ({:.1} spp on average) in {total:.2} s (sampling {:.2} s, allocation {:.2} s, reconstruction {:.2} s{}){reached}\n",
         r.method.with_denoiser(a.denoise),
         r.samples,
         r.samples as f64 / n,
         r.timing.sampling,
+        r.timing.allocation,
         r.timing.reconstruction,
         if a.denoise == Denoise::None {
             String::new()
