@@ -2,7 +2,8 @@
 # The Slurm test: a real single-node Slurm cluster (controller and node on this machine,
 # from Debian's slurmctld, slurmd, slurm-client and munge packages) renders a scene as a
 # 4-part job array followed by a dependent merge; the merged image must be the
-# single-process render's (their digests, of every pixel's f64 bits, must agree).
+# single-process render's with the same settings, `--parts 4` (their digests, of every
+# pixel's f64 bits, must agree).
 #
 #   bash examples/slurm/test.sh            # from the repository's root
 #
@@ -148,7 +149,7 @@ log=$(ls "$dir"/work/covtrace-merge-*.log 2>/dev/null | head -n 1)
 [ -n "$log" ] || fail "the merge job left no log"
 merged=$(sed -n 's/^image digest: //p' "$log")
 [ -n "$merged" ] || fail "the merge printed no image digest: $(cat "$log")"
-single=$("$COVTRACE" render "$scene" "${opts[@]}" -o "$dir/work/single.exr" 2>/dev/null | sed -n 's/^image digest: //p')
+single=$("$COVTRACE" render "$scene" --parts 4 "${opts[@]}" -o "$dir/work/single.exr" 2>/dev/null | sed -n 's/^image digest: //p')
 grep '^  part' "$log" | sed 's/^ */slurm test: /'
 if [ "$merged" != "$single" ]; then
   fail "the merged image ($merged) is not the single-process render ($single)"

@@ -76,6 +76,10 @@ pub struct BenchArgs {
     /// Seed of the runs (the reference uses another).
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
+    /// Split each run's allocation into this many parts of the rows, as a render in parts
+    /// does (`covtrace render --parts N`): what splitting costs in error.
+    #[arg(long, default_value_t = 1)]
+    pub parts: u32,
     /// Output folder (created if missing; its parent must exist).
     #[arg(short, long, default_value = "render-bench")]
     pub output: PathBuf,
@@ -285,6 +289,7 @@ pub fn bench(a: &BenchArgs) -> Result<String, String> {
         denoise,
         cov_paths: a.cov_paths,
         cov_stride: a.cov_stride,
+        parts: a.parts,
         ..RenderSettings::default()
     };
     // Every run goes through the library's renderer, with the covariance guide traced

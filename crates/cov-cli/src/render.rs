@@ -52,9 +52,15 @@ pub struct RenderArgs {
     #[arg(long, value_parser = parse_size)]
     pub size: Option<(u32, u32)>,
     /// Render only part I of N (`I/N`, e.g. `2/4`) and write it as a part file (EXR) for
-    /// `covtrace merge`: a job array renders the parts, one merge makes the image.
+    /// `covtrace merge`: a job array renders the parts, one merge makes the image, which is
+    /// the image of `--parts N` in one process.
     #[arg(long, value_parser = parse_part)]
     pub part: Option<Part>,
+    /// Split the allocation of samples into N parts of the rows, each spending its own
+    /// pixels' share of the budget, as a render in N parts does (default 1: the budget is
+    /// spread over the whole image).
+    #[arg(long)]
+    pub parts: Option<u32>,
     /// Render frame K of an animation: the shutter moves by K / the scene's frame_rate.
     #[arg(long, conflicts_with = "frames")]
     pub frame: Option<u32>,
@@ -153,7 +159,8 @@ pub fn parse_method(s: &str) -> Result<Method, String> {
 /// when out of range.
 ///
 /// # Errors
-/// `--spp`, `--time`, `--cov-paths` or `--cov-stride` out of range.
+/// `--spp`, `--time`, `--cov-paths`, `--cov-stride` or `--parts` out of range; `--part`
+/// and `--parts` that disagree.
 pub fn settings(a: &RenderArgs) -> Result<RenderSettings, String> {
     let s = RenderSettings {
         method: a.method,
@@ -164,6 +171,16 @@ pub fn settings(a: &RenderArgs) -> Result<RenderSettings, String> {
         cov_stride: a.cov_stride,
         max_luminance: f64::INFINITY,
         denoise: a.denoise,
+        parts: match (a.part, a.parts) {
+            (Some(p), Some(n)) if p.count != n => {
+                return Err(format!(
+                    "--part {p} renders a part of {} parts, but --parts is {n}",
+                    p.count
+                ));
+            }
+            (Some(p), _) => p.count,
+            (None, n) => n.unwrap_or(1),
+        },
     };
     // The library's own check, its setting named as the flag the user wrote.
     s.check().map_err(|e| match e {
@@ -284,10 +301,9 @@ pub fn run(a: &RenderArgs) -> Result<String, String> {
         return Err("--part and --time exclude each other: a part renders a fixed budget".into());
     }
     let world = load(&a.scene, a.size)?;
-    let (h, part) = (world.camera.height, a.part);
-    if let Some(p) = part {
-        p.rows(h).map_err(|e| format!("--{e}"))?;
-    }
+    let index = a.part.map_or(1, |p| p.index);
+    cov_render::renderer::part_rows(world.camera.height, index, settings.parts)
+        .map_err(|e| format!("--{e}"))?;
     match (a.frame, a.frames) {
         (_, Some((first, last))) => {
             let mut world = world;

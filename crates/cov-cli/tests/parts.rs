@@ -35,9 +35,14 @@ const OPTS: [&str; 6] = ["--size", "40x96", "--spp", "4", "--seed", "2"];
 #[test]
 fn merged_parts_are_the_single_render() {
     let single = tmp("single.exr");
-    let mut args = vec!["render", SCENE, "-o", s(&single)];
+    let mut args = vec!["render", SCENE, "--parts", "3", "-o", s(&single)];
     args.extend(OPTS);
     let want = digest(&covtrace(&args));
+    // Without --parts the budget is spread over the whole image: another image.
+    let whole = tmp("whole.exr");
+    let mut args = vec!["render", SCENE, "-o", s(&whole)];
+    args.extend(OPTS);
+    assert_ne!(digest(&covtrace(&args)), want);
     let parts: Vec<PathBuf> = (1..=3).map(|i| tmp(&format!("part{i}.exr"))).collect();
     // In reverse order: the parts do not depend on one another.
     for (i, p) in parts.iter().enumerate().rev() {
@@ -98,7 +103,15 @@ fn bad_part_options_get_one_line() {
     let out_file = tmp("bad.exr");
     for (args, want) in [
         (vec!["--part", "0/2"], "--part must be I/N"),
-        (vec!["--part", "3/4", "--size", "40x64"], "N ≤ 2"),
+        (
+            vec!["--part", "3/5", "--size", "40x64"],
+            "--parts must be 1 to 4 for this image",
+        ),
+        (
+            vec!["--part", "1/2", "--parts", "3"],
+            "--part 1/2 renders a part of 2 parts, but --parts is 3",
+        ),
+        (vec!["--parts", "0"], "--parts must be 1 to 512"),
         (
             vec!["--part", "1/2", "--time", "1"],
             "--part and --time exclude each other",

@@ -1,10 +1,14 @@
 //! A render split into parts, for many processes or machines (a Slurm job array,
 //! `examples/slurm/`), and merged into exactly the image one process renders.
 //!
-//! **What a part owns.** The image's rows form allocation bands of
-//! [`crate::renderer::ALLOC_BAND`] rows; every band spends its own pixels' share of the
-//! budget, in one process as in parts. Part `I` of `N` ([`Part`]) owns bands
-//! `⌊(I−1)·B/N⌋ .. ⌊I·B/N⌋` of the image's `B` bands, so the parts cover every row once.
+//! **What a part owns.** Part `I` of `N` ([`Part`]) owns whole tile rows,
+//! `⌊(I−1)·T/N⌋ .. ⌊I·T/N⌋` of the image's `T` tile rows
+//! ([`part_rows`](crate::renderer::part_rows)), so the parts cover every row once. Each
+//! part spends its own pixels' share of the budget: the render in parts is the render with
+//! [`RenderSettings::parts`] = `N` (`covtrace render --parts N` in one process), whose
+//! allocation is split the same way. `N = 1`, the default, spreads the budget over the
+//! whole image; splitting keeps samples from moving between parts, which costs some error
+//! where the detail is unevenly spread over the rows (docs/render-bench.md).
 //!
 //! **What a part computes.** Everything its own pixels' samples depend on, and nothing
 //! else ([`Renderer::render_part`](crate::Renderer::render_part)):
@@ -12,7 +16,7 @@
 //!   rows on each side;
 //! - the pilot over its rows and [`PILOT_MARGIN`](crate::renderer::PILOT_MARGIN) rows on
 //!   each side;
-//! - the allocation of its bands, and the rest of their samples.
+//! - the allocation of its rows, and the rest of their samples.
 //!
 //! The margins are as deep as the allocation reads. A pixel's share follows the guard's
 //! choice, which averages the candidates' error estimates over 3×3 pixels. Each estimate
@@ -51,12 +55,11 @@ use crate::film::Progress;
 use crate::film::{Film, Image};
 use crate::guard::candidates;
 use crate::renderer::{
-    ALLOC_BAND, Method, RenderSettings, Renderer, Sampled, Timing, Window, reconstruct, timed,
+    Method, RenderSettings, Renderer, Sampled, Timing, Window, part_rows, reconstruct, timed,
 };
 use crate::{RenderError, World};
 
-/// Most parts a render splits into: the bands of the largest image.
-pub const MAX_PARTS: u32 = crate::scene::MAX_RESOLUTION / ALLOC_BAND;
+pub use crate::renderer::MAX_PARTS;
 /// Version of the part file's layout and key.
 pub const FORMAT: u32 = 1;
 /// Most channels a part file may hold (the film's 32 and the maps' 10 fit).
@@ -92,21 +95,9 @@ impl Part {
     /// The rows this part owns in an image of `height` rows (module docs).
     ///
     /// # Errors
-    /// More parts than the image has bands.
+    /// More parts than the image has tile rows.
     pub fn rows(self, height: u32) -> Result<Range<u32>, RenderError> {
-        let bands = height.div_ceil(ALLOC_BAND);
-        if self.index == 0 || self.index > self.count || self.count > bands {
-            return Err(RenderError::setting(
-                "part",
-                format!(
-                    "I/N with 1 ≤ I ≤ N ≤ {bands} (the image's {height} rows make {bands} bands of {ALLOC_BAND} rows)"
-                ),
-                format!("{}/{}", self.index, self.count),
-            ));
-        }
-        let band = |k: u32| (u64::from(k) * u64::from(bands) / u64::from(self.count)) as u32;
-        let (b0, b1) = (band(self.index - 1), band(self.index));
-        Ok(b0 * ALLOC_BAND..(b1 * ALLOC_BAND).min(height))
+        part_rows(height, self.index, self.count)
     }
 
     /// The rows each stage of this part computes.
@@ -128,9 +119,16 @@ impl Renderer<'_> {
     /// reconstructed: [`merge`] does that from all the parts.
     ///
     /// # Errors
-    /// More parts than the image has allocation bands; a time limit (a part renders a fixed
-    /// budget); the covariance pass's errors.
+    /// A part whose count is not the settings' [`RenderSettings::parts`]; a time limit (a
+    /// part renders a fixed budget); the covariance pass's errors.
     pub fn render_part(&mut self, part: Part, progress: Progress<'_>) -> Result<PartFilm, RenderError> {
+        if part.count != self.settings().parts {
+            return Err(RenderError::setting(
+                "parts",
+                format!("the part's count (part {part})"),
+                self.settings().parts,
+            ));
+        }
         if self.settings().time.is_some() {
             return Err(RenderError::setting(
                 "time",
@@ -190,13 +188,13 @@ pub struct PartKey {
     pub max_luminance: String,
     /// The denoiser's name.
     pub denoise: String,
-    /// Parts the render is split into.
+    /// Parts the render is split into ([`RenderSettings::parts`]).
     pub parts: u32,
 }
 
 impl PartKey {
-    /// The key of `world` rendered with `settings` in `parts` parts.
-    pub fn new(world: &World, settings: &RenderSettings, parts: u32) -> PartKey {
+    /// The key of `world` rendered with `settings`.
+    pub fn new(world: &World, settings: &RenderSettings) -> PartKey {
         PartKey {
             format: FORMAT,
             scene: format!("{:016x}", world.fingerprint),
@@ -210,7 +208,7 @@ impl PartKey {
             cov_stride: settings.cov_stride,
             max_luminance: settings.max_luminance.to_string(),
             denoise: settings.denoise.name().into(),
-            parts,
+            parts: settings.parts,
         }
     }
 
@@ -282,7 +280,7 @@ impl PartFilm {
         };
         let uses = settings.method.uses_covariance();
         PartFilm {
-            key: PartKey::new(world, settings, part.count),
+            key: PartKey::new(world, settings),
             part,
             maps: maps.filter(|_| uses).map(|m| crop(&m.pixels, w, &rows)),
             layout: maps.filter(|_| uses).map_or(0, |m| m.layout),
@@ -715,14 +713,13 @@ mod tests {
         let edge = (EDGE_REACH * MAX_FILTER).ceil() as u32 + 1;
         assert!(PILOT_MARGIN >= (1 + splat).max(2) && PILOT_MARGIN.is_multiple_of(TILE));
         assert!(GUIDE_MARGIN >= 1 + splat + edge && GUIDE_MARGIN.is_multiple_of(TILE));
-        assert!(ALLOC_BAND.is_multiple_of(TILE));
     }
 
     #[test]
     fn parts_cover_every_row_once() {
         for h in [1u32, 31, 32, 33, 96, 100, 192, 1080] {
-            let bands = h.div_ceil(ALLOC_BAND);
-            for n in 1..=bands.min(9) {
+            let bands = h.div_ceil(TILE);
+            for n in (1..=bands.min(9)).chain([bands]) {
                 let mut next = 0;
                 for i in 1..=n {
                     let r = Part { index: i, count: n }.rows(h).unwrap();

@@ -162,6 +162,11 @@ pub struct RenderSettings {
     pub max_luminance: f64,
     /// A denoiser run on the reconstructed image ([`crate::denoise`]).
     pub denoise: Denoise,
+    /// Parts the image's rows are split into (1 to [`MAX_PARTS`], at most one per tile
+    /// row): each part spends its own pixels' share of the budget ([`part_rows`]). 1 (the
+    /// default) distributes the budget over the whole image; a render in `N` parts (the
+    /// `parts` module) is this render with `parts: N`, bit for bit.
+    pub parts: u32,
 }
 
 impl Default for RenderSettings {
@@ -177,6 +182,7 @@ impl Default for RenderSettings {
             cov_stride: 4,
             max_luminance: f64::INFINITY,
             denoise: Denoise::None,
+            parts: 1,
         }
     }
 }
@@ -216,6 +222,13 @@ impl RenderSettings {
                 "cov_stride",
                 format!("one of {STRIDES:?}"),
                 self.cov_stride,
+            ));
+        }
+        if !(1..=MAX_PARTS).contains(&self.parts) {
+            return Err(RenderError::setting(
+                "parts",
+                format!("1 to {MAX_PARTS}"),
+                self.parts,
             ));
         }
         if self.max_luminance.is_nan() || self.max_luminance <= 0.0 {
@@ -265,9 +278,11 @@ impl<'w> Renderer<'w> {
     /// A renderer of `world` with `settings`.
     ///
     /// # Errors
-    /// A setting out of range ([`RenderSettings::check`]).
+    /// A setting out of range ([`RenderSettings::check`]), or more parts than the image
+    /// has tile rows ([`part_rows`]).
     pub fn new(world: &'w World, settings: RenderSettings) -> Result<Renderer<'w>, RenderError> {
         settings.check()?;
+        part_rows(world.camera.height, 1, settings.parts)?;
         Ok(Renderer {
             world,
             settings,
@@ -441,9 +456,9 @@ impl<'w> Renderer<'w> {
             timing
                 .sample(|| film.render_rows(world, counts, s.seed, s.max_luminance, rows.clone(), progress));
         };
-        // Samples per pixel in proportion to `weights`, each band of rows its own budget.
+        // Samples per pixel in proportion to `weights`, each part of the rows its own budget.
         let bands = |weights: &[f64], floors: &[u32], hi: u32, pow2: bool| {
-            allocate_bands(w, &win.owned, weights, floors, s.spp, hi, pow2)
+            allocate_parts(w, h, s.parts, &win.owned, weights, floors, s.spp, hi, pow2)
         };
         // The first pass.
         let (mut counts, t) = timed(|| match (method, guide) {
@@ -558,13 +573,31 @@ pub(crate) struct Sampled {
     pub cands: Vec<Vec<Gaussian>>,
 }
 
-/// Rows of the image whose pixels share one allocation of samples: each band of
-/// `ALLOC_BAND` rows (the last one shorter) spends its own pixels' share of the budget,
-/// distributed by the method's weights. A render split into parts (the `parts` module)
-/// gives each part whole bands, so that the parts' allocations are the single render's. Two
-/// tiles, so that an image of a few hundred rows still splits into several parts, while a
-/// band (two tiles by the image's width) still holds both flat regions and detail.
-pub const ALLOC_BAND: u32 = 2 * crate::film::TILE;
+/// Most parts a render splits into ([`RenderSettings::parts`]): one per tile row of the
+/// tallest image.
+pub const MAX_PARTS: u32 = crate::scene::MAX_RESOLUTION / crate::film::TILE;
+
+/// The rows of part `index` (1-based) of `parts` in an image of `height` rows: whole tile
+/// rows, `⌊(index−1)·T/parts⌋ .. ⌊index·T/parts⌋` of the image's `T` tile rows, so that the
+/// parts cover every row once.
+///
+/// # Errors
+/// `index` outside `1..=parts`, or more parts than the image has tile rows.
+pub fn part_rows(height: u32, index: u32, parts: u32) -> Result<Range<u32>, RenderError> {
+    let tile = crate::film::TILE;
+    let rows = height.div_ceil(tile);
+    if index == 0 || index > parts || parts > rows {
+        return Err(RenderError::setting(
+            "parts",
+            format!(
+                "1 to {rows} for this image (its {height} rows make {rows} tile rows of {tile}), with 1 ≤ part ≤ parts"
+            ),
+            format!("part {index} of {parts}"),
+        ));
+    }
+    let at = |k: u32| (u64::from(k) * u64::from(rows) / u64::from(parts)) as u32 * tile;
+    Ok(at(index - 1)..at(index).min(height))
+}
 
 /// Rows of pilot samples a part of a render takes on each side of its own rows: the
 /// guard's choice at an owned row reads error estimates one row away, which read the
@@ -609,10 +642,14 @@ impl Window {
     }
 }
 
-/// Samples per pixel ∝ `weights` between `floors` and `hi` ([`allocate_floors`]), each band
-/// of [`ALLOC_BAND`] rows of `owned` spending `spp` times its pixels; 0 outside `owned`.
-fn allocate_bands(
+/// Samples per pixel ∝ `weights` between `floors` and `hi` ([`allocate_floors`]), each of
+/// the `parts` parts of an image of `height` rows ([`part_rows`]) that `owned` holds
+/// spending `spp` times its pixels; 0 outside `owned`.
+#[allow(clippy::too_many_arguments)]
+fn allocate_parts(
     width: u32,
+    height: u32,
+    parts: u32,
     owned: &Range<u32>,
     weights: &[f64],
     floors: &[u32],
@@ -622,10 +659,15 @@ fn allocate_bands(
 ) -> Vec<u32> {
     let w = width as usize;
     let mut counts = vec![0; weights.len()];
-    let mut y = owned.start;
-    while y < owned.end {
-        let y1 = (y + ALLOC_BAND - y % ALLOC_BAND).min(owned.end);
-        let r = y as usize * w..y1 as usize * w;
+    for k in 1..=parts {
+        // `Renderer::new` checked `parts` against the image.
+        let Ok(rows) = part_rows(height, k, parts) else {
+            continue;
+        };
+        if rows.start < owned.start || rows.end > owned.end {
+            continue;
+        }
+        let r = rows.start as usize * w..rows.end as usize * w;
         let c = allocate_floors(
             &weights[r.clone()],
             spp * r.len() as f64,
@@ -634,7 +676,6 @@ fn allocate_bands(
             pow2,
         );
         counts[r].copy_from_slice(&c);
-        y = y1;
     }
     counts
 }

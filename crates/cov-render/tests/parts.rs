@@ -32,6 +32,10 @@ fn temp(name: &str) -> PathBuf {
 
 /// Renders `n` parts, through their files.
 fn parts(world: &World, s: &RenderSettings, n: u32, tag: &str) -> Vec<PartFilm> {
+    let s = RenderSettings {
+        parts: n,
+        ..s.clone()
+    };
     (1..=n)
         .map(|index| {
             let part = Part { index, count: n };
@@ -52,16 +56,20 @@ fn parts(world: &World, s: &RenderSettings, n: u32, tag: &str) -> Vec<PartFilm> 
 
 /// Every method, on a scene with defocus, motion and material edges (chess) and on one
 /// with soft shadows and a light's edge (cornell), tall enough that parts have margins
-/// short of the image: the merged image, film and maps equal the single render's bits.
+/// short of the image: the merged image, film and maps equal the bits of the render with
+/// as many parts in one process.
 #[test]
 fn merged_parts_are_the_single_render() {
     for (name, w, h) in [("chess.ron", 40, 232), ("cornell.ron", 48, 200)] {
         let world = scene(name, w, h);
         for method in Method::ALL {
-            let s = settings(method, 3);
-            let mut single = Renderer::new(&world, s.clone()).unwrap();
-            let one = single.render(None).unwrap();
-            for n in [3, (h.div_ceil(cov_render::renderer::ALLOC_BAND))] {
+            for n in [1, 3, h.div_ceil(16)] {
+                let s = RenderSettings {
+                    parts: n,
+                    ..settings(method, 3)
+                };
+                let mut single = Renderer::new(&world, s.clone()).unwrap();
+                let one = single.render(None).unwrap();
                 let merged = merge(&parts(&world, &s, n, &format!("{}-{n}", method.name()))).unwrap();
                 assert!(
                     merged.film == one.film,
@@ -89,11 +97,36 @@ fn merged_parts_are_the_single_render() {
     }
 }
 
+/// One part is the render itself; parts change only where the budget goes, not how much.
+#[test]
+fn one_part_is_the_render_and_parts_keep_the_budget() {
+    let world = scene("cornell.ron", 32, 96);
+    let s = settings(Method::Cov, 1);
+    let one = Renderer::new(&world, s.clone()).unwrap().render(None).unwrap();
+    let merged = merge(&parts(&world, &s, 1, "whole")).unwrap();
+    assert!(merged.image == one.image && merged.film == one.film);
+    let split = Renderer::new(&world, RenderSettings { parts: 3, ..s })
+        .unwrap()
+        .render(None)
+        .unwrap();
+    assert!(split.film.count != one.film.count, "the allocation is split");
+    let ratio = split.samples as f64 / one.samples as f64;
+    assert!(
+        (ratio - 1.0).abs() < 0.01,
+        "{} against {}",
+        split.samples,
+        one.samples
+    );
+}
+
 /// Each part samples its own rows only; the pilot and the pass reach only its margins.
 #[test]
 fn a_part_takes_its_own_samples() {
     let world = scene("cornell.ron", 32, 256);
-    let s = settings(Method::Cov, 1);
+    let s = RenderSettings {
+        parts: 4,
+        ..settings(Method::Cov, 1)
+    };
     let one = Renderer::new(&world, s.clone()).unwrap().render(None).unwrap();
     let total: u64 = parts(&world, &s, 4, "share").iter().map(PartFilm::samples).sum();
     assert_eq!(total, one.samples);
@@ -144,16 +177,32 @@ fn bad_parts_are_refused_with_one_line() {
     for p in [f, cut, foreign, text] {
         let _ = std::fs::remove_file(p);
     }
-    // More parts than bands; a time limit.
-    let e = Renderer::new(&world, s.clone())
-        .unwrap()
-        .render_part(Part { index: 1, count: 4 }, None)
-        .unwrap_err();
-    assert!(line(e).contains("N ≤ 3"));
-    let timed = RenderSettings { time: Some(1.0), ..s };
-    let e = Renderer::new(&world, timed)
+    // More parts than tile rows; a part of another count than the settings'; a time limit.
+    let e = Renderer::new(
+        &world,
+        RenderSettings {
+            parts: 7,
+            ..s.clone()
+        },
+    )
+    .unwrap_err();
+    assert!(line(e).contains("1 to 6 for this image"));
+    let three = RenderSettings {
+        parts: 3,
+        ..s.clone()
+    };
+    let e = Renderer::new(&world, three.clone())
         .unwrap()
         .render_part(Part { index: 1, count: 2 }, None)
+        .unwrap_err();
+    assert!(line(e).contains("part 1/2"));
+    let timed = RenderSettings {
+        time: Some(1.0),
+        ..three
+    };
+    let e = Renderer::new(&world, timed)
+        .unwrap()
+        .render_part(Part { index: 1, count: 3 }, None)
         .unwrap_err();
     assert!(line(e).contains("time"));
 }
