@@ -3,7 +3,7 @@
 //!
 //! **What a part owns.** Part `I` of `N` ([`Part`]) owns whole tile rows,
 //! `⌊(I−1)·T/N⌋ .. ⌊I·T/N⌋` of the image's `T` tile rows
-//! ([`part_rows`](crate::renderer::part_rows)), so the parts cover every row once. Each
+//! ([`part_rows`]), so the parts cover every row once. Each
 //! part spends its own pixels' share of the budget: the render in parts is the render with
 //! [`RenderSettings::parts`] = `N` (`covtrace render --parts N` in one process), whose
 //! allocation is split the same way. `N = 1`, the default, spreads the budget over the
