@@ -138,12 +138,7 @@ impl Param {
     /// in words (`must be > focal_length = 0.05`).
     #[cold]
     pub fn error(&self, value: f64, expected: impl Into<String>) -> CovError {
-        CovError::OutOfRange {
-            operator: self.operator.into(),
-            parameter: self.name.into(),
-            value,
-            expected: expected.into(),
-        }
+        self.of(value).error(expected)
     }
 
     /// `value` if it is finite and `ok(value)`, else the error naming this parameter, with
@@ -158,7 +153,7 @@ impl Param {
         ok: impl FnOnce(f64) -> bool,
         expected: impl FnOnce() -> String,
     ) -> Result<f64, CovError> {
-        self.require_named(None, value, ok, expected)
+        self.of(value).require(ok, expected)
     }
 
     /// [`Param::require`] for element `k` of a list parameter (named `values[k]`).
@@ -173,42 +168,11 @@ impl Param {
         ok: impl FnOnce(f64) -> bool,
         expected: impl FnOnce() -> String,
     ) -> Result<f64, CovError> {
-        self.require_named(Some(k), value, ok, expected)
-    }
-
-    #[inline(always)]
-    fn require_named(
-        &self,
-        k: Option<usize>,
-        value: f64,
-        ok: impl FnOnce(f64) -> bool,
-        expected: impl FnOnce() -> String,
-    ) -> Result<f64, CovError> {
-        if value.is_finite() && ok(value) {
-            return Ok(value);
-        }
-        Err(self.fail(k, value, value.is_finite().then(expected)))
-    }
-
-    #[cold]
-    fn fail(&self, k: Option<usize>, value: f64, expected: Option<String>) -> CovError {
-        let parameter = match k {
-            Some(k) => format!("{}[{k}]", self.name),
-            None => self.name.to_string(),
+        let arg = Arg {
+            index: Some(k),
+            ..self.of(value)
         };
-        match expected {
-            None => CovError::NonFinite {
-                operator: self.operator.into(),
-                parameter,
-                value,
-            },
-            Some(expected) => CovError::OutOfRange {
-                operator: self.operator.into(),
-                parameter,
-                value,
-                expected,
-            },
-        }
+        arg.require(ok, expected)
     }
 }
 
@@ -262,17 +226,6 @@ impl Arg {
         }
     }
 
-    fn param(&self) -> Param {
-        Param {
-            operator: self.operator,
-            name: self.name,
-            unit: "",
-            doc: "",
-            default: None,
-            domain: "",
-        }
-    }
-
     /// The value if it is finite and `ok(value)`.
     ///
     /// # Errors
@@ -286,9 +239,7 @@ impl Arg {
         if self.value.is_finite() && ok(self.value) {
             return Ok(self.value);
         }
-        Err(self
-            .param()
-            .fail(self.index, self.value, self.value.is_finite().then(expected)))
+        Err(self.fail(self.value.is_finite().then(expected)))
     }
 
     /// The value if it is finite.
@@ -321,7 +272,30 @@ impl Arg {
     /// The error for this value, out of its domain.
     #[cold]
     pub fn error(self, expected: impl Into<String>) -> CovError {
-        self.param().fail(self.index, self.value, Some(expected.into()))
+        self.fail(Some(expected.into()))
+    }
+
+    /// [`CovError::NonFinite`] without `expected`, else [`CovError::OutOfRange`].
+    #[cold]
+    fn fail(self, expected: Option<String>) -> CovError {
+        let (operator, value) = (self.operator.into(), self.value);
+        let parameter = match self.index {
+            Some(k) => format!("{}[{k}]", self.name),
+            None => self.name.to_string(),
+        };
+        match expected {
+            None => CovError::NonFinite {
+                operator,
+                parameter,
+                value,
+            },
+            Some(expected) => CovError::OutOfRange {
+                operator,
+                parameter,
+                value,
+                expected,
+            },
+        }
     }
 }
 
