@@ -457,16 +457,16 @@ impl<'w> Renderer<'w> {
                 .sample(|| film.render_rows(world, counts, s.seed, s.max_luminance, rows.clone(), progress));
         };
         // Samples per pixel in proportion to `weights`, each part of the rows its own budget.
-        let bands = |weights: &[f64], floors: &[u32], hi: u32, pow2: bool| {
+        let share = |weights: &[f64], floors: &[u32], hi: u32, pow2: bool| {
             allocate_parts(w, h, s.parts, &win.owned, weights, floors, s.spp, hi, pow2)
         };
         // The first pass.
         let (mut counts, t) = timed(|| match (method, guide) {
             (Method::CovDensity, Some(g)) => {
                 let lo = ((s.spp / 4.0).floor() as u32).max(1);
-                bands(&g.density, &vec![lo; n], hi, false)
+                share(&g.density, &vec![lo; n], hi, false)
             }
-            _ => bands(&vec![1.0; n], &vec![1; n], MAX_SPP, false),
+            _ => share(&vec![1.0; n], &vec![1; n], MAX_SPP, false),
         });
         // The allocation after a pilot, per pixel: a weight and a floor. The weight is the
         // relative standard deviation (blurred over 3×3 pixels); for covariance tracing,
@@ -515,7 +515,7 @@ impl<'w> Renderer<'w> {
                     sample(&mut film, &vec![p; n], &win.pilot, &mut timing);
                     let (rest, secs) = timed(|| {
                         let (wts, floors) = plan(&film, p);
-                        bands(&wts, &floors, hi.max(p), true)
+                        share(&wts, &floors, hi.max(p), true)
                             .into_iter()
                             .map(|c| c.saturating_sub(p))
                             .collect::<Vec<u32>>()
@@ -546,7 +546,7 @@ impl<'w> Renderer<'w> {
                 if method.has_pilot() {
                     let (c, secs) = timed(|| {
                         let (wts, floors) = plan(&film, 1);
-                        bands(&wts, &floors, hi, true)
+                        share(&wts, &floors, hi, true)
                     });
                     timing.allocation += secs;
                     counts = c;
