@@ -120,7 +120,8 @@ impl Renderer<'_> {
     ///
     /// # Errors
     /// A part whose count is not the settings' [`RenderSettings::parts`]; a time limit (a
-    /// part renders a fixed budget); the covariance pass's errors.
+    /// part renders a fixed budget); a renderer given a guide ([`Renderer::with_guide`]),
+    /// for a method that traces the covariance; the covariance pass's errors.
     pub fn render_part(&mut self, part: Part, progress: Progress<'_>) -> Result<PartFilm, RenderError> {
         if part.count != self.settings().parts {
             return Err(RenderError::setting(
@@ -138,6 +139,12 @@ impl Renderer<'_> {
         }
         let win = part.window(self.world.camera.height)?;
         let Sampled { film, timing, .. } = self.sample(&win, progress)?;
+        if self.settings().method.uses_covariance() && self.maps().is_none() {
+            // A guide given to the renderer has no maps for the part file to carry.
+            return Err(RenderError::Parts(
+                "a part traces its own covariance pass: render it without a given guide".into(),
+            ));
+        }
         Ok(PartFilm::new(
             self.world,
             self.settings(),

@@ -205,6 +205,15 @@ fn bad_parts_are_refused_with_one_line() {
         .render_part(Part { index: 1, count: 3 }, None)
         .unwrap_err();
     assert!(line(e).contains("time"));
+    // A renderer given a guide has no maps for the part file.
+    let maps = cov_render::covariance_maps(&world, 1, 4, 1, None).unwrap();
+    let guide = cov_render::adaptive::Guide::new(&maps, 0.0);
+    let e = Renderer::new(&world, RenderSettings { parts: 3, ..s })
+        .and_then(|r| r.with_guide(guide))
+        .unwrap()
+        .render_part(Part { index: 1, count: 3 }, None)
+        .unwrap_err();
+    assert!(line(e).contains("its own covariance pass"));
 }
 
 /// A frame moves the shutter by frame / frame_rate: a moving object is where its velocity
