@@ -620,10 +620,10 @@ pub fn merge(parts: &[PartFilm]) -> Result<Merged, RenderError> {
         .first()
         .ok_or_else(|| RenderError::setting("parts", "at least one part file", "none"))?;
     let key = &first.key;
-    let setting = RenderError::Parts;
+    let bad = RenderError::Parts;
     for p in &parts[1..] {
         if let Some(d) = p.key.difference(key) {
-            return Err(setting(format!(
+            return Err(bad(format!(
                 "{} and {} are parts of different renders: {d}",
                 p.source, first.source
             )));
@@ -634,7 +634,7 @@ pub fn merge(parts: &[PartFilm]) -> Result<Merged, RenderError> {
     for p in parts {
         let slot = &mut owner[(p.part.index - 1) as usize];
         if let Some(q) = slot {
-            return Err(setting(format!(
+            return Err(bad(format!(
                 "part {} is given twice: {} and {}",
                 p.part, q.source, p.source
             )));
@@ -647,15 +647,15 @@ pub fn merge(parts: &[PartFilm]) -> Result<Merged, RenderError> {
             count: key.parts,
         };
         let rows = part.rows(h)?;
-        return Err(setting(format!(
+        return Err(bad(format!(
             "part {part} (rows {}..{}) is missing: the parts must cover every row once",
             rows.start, rows.end
         )));
     }
     let method = Method::from_name(&key.method)
-        .ok_or_else(|| setting(format!("an unknown method `{}`", crate::echo(&key.method))))?;
+        .ok_or_else(|| bad(format!("an unknown method `{}`", crate::echo(&key.method))))?;
     let denoise = Denoise::from_name(&key.denoise)
-        .ok_or_else(|| setting(format!("an unknown denoiser `{}`", crate::echo(&key.denoise))))?;
+        .ok_or_else(|| bad(format!("an unknown denoiser `{}`", crate::echo(&key.denoise))))?;
     let wu = w as usize;
     let mut film = Film::new(w, h);
     let mut pixels = vec![PixelCov::default(); wu * h as usize];
