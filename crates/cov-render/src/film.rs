@@ -21,6 +21,8 @@
 //! Rendering goes tile by tile over rayon and reconstruction band by band; both add their
 //! parts in a fixed order, so images do not depend on the thread count.
 
+use std::ops::Range;
+
 use glam::DVec3;
 use rayon::prelude::*;
 
@@ -116,7 +118,7 @@ pub struct Gaussian {
     norm: f64,
     /// Larger std (px).
     std_max: f64,
-    /// `exp(−precision_xx)`: the recurrence factor of [`Gaussian::splat_row`].
+    /// `exp(−precision_xx)`: the recurrence factor of [`Gaussian::row_weights`].
     decay: f64,
 }
 
@@ -181,54 +183,75 @@ impl Gaussian {
         [r / det, -q / det, p / det]
     }
 
-    /// Calls `add(cell, weight)` for the cells `x − r ..= x + r` of `row` (clipped to it) at
-    /// vertical offset `dy`, with the weight at offset `(cell − x, dy)` where it is inside
-    /// the [`CUTOFF`] ellipse. Walks outward from the row's peak with the Gaussian's
-    /// ratio recurrence (two products a cell, two `exp` a row), so the
-    /// weights only decrease along a walk and underflow stops it, never skips a cell.
-    pub fn splat_row<T>(&self, row: &mut [T], x: usize, dy: f64, r: usize, mut add: impl FnMut(&mut T, f64)) {
+    /// The weights of the cells at horizontal offset `lo ..= hi` and vertical offset `dy`
+    /// that lie inside the [`CUTOFF`] ellipse (a row of an ellipse is one run of cells),
+    /// appended to `out`; returns the run's first offset.
+    ///
+    /// The run is found around the row's minimum `c₀ = −q dy / p` (half-width
+    /// `√((cut − e(c₀)) / p)`), then corrected cell by cell against the exponent itself, so
+    /// that rounding neither adds nor drops a cell that [`Gaussian::weight`] weighs
+    /// otherwise. The weights come from the Gaussian's ratio recurrence,
+    /// `w(d + 1) / w(d) = exp(−½ (p (2d + 1) + 2 q dy))`, a ratio that itself changes by
+    /// `exp(−p)` a cell (`p`, `q`: the precision's `xx`, `xy`), run in four interleaved
+    /// lanes of four-cell steps so that neighbouring cells do not wait on each other's
+    /// product: two `exp` a row, two products a cell.
+    fn row_weights(&self, dy: f64, lo: i64, hi: i64, out: &mut Vec<f64>) -> i64 {
         let [p, q, rr] = self.precision;
-        let lo = x.saturating_sub(r) as i64 - x as i64;
-        let hi = ((x + r).min(row.len().saturating_sub(1)) as i64) - x as i64;
-        if lo > hi {
-            return;
-        }
-        let e_at = |dx: f64| p * dx * dx + 2.0 * q * dx * dy + rr * dy * dy;
-        let c = ((-q * dy / p).round() as i64).clamp(lo, hi);
+        let e_at = |dx: i64| {
+            let dx = dx as f64;
+            p * dx * dx + 2.0 * q * dx * dy + rr * dy * dy
+        };
         let cut = CUTOFF * CUTOFF;
+        let c0 = -q * dy / p;
+        let half = ((cut - (rr - q * q / p) * dy * dy).max(0.0) / p).sqrt();
+        // `as` saturates and truncates towards zero; the corrections below do the rest.
+        let mut a = ((c0 - half) as i64).clamp(lo, hi + 1);
+        let mut b = ((c0 + half) as i64).clamp(lo - 1, hi);
+        while a <= b && e_at(a) > cut {
+            a += 1;
+        }
+        while a > lo && e_at(a - 1) <= cut {
+            a -= 1;
+        }
+        while b >= a && e_at(b) > cut {
+            b -= 1;
+        }
+        while b >= a && b < hi && e_at(b + 1) <= cut {
+            b += 1;
+        }
+        if b < a {
+            return a;
+        }
+        let n = (b - a + 1) as usize;
+        // Lane j starts at cell a + j and steps four cells: w(d + 4) / w(d) = ∏ of four
+        // one-cell ratios = step(d)⁴ · decay⁶, which changes by decay¹⁶ a step.
         let decay = self.decay;
-        // w(c ± 1) / w(c) = exp(∓(½p(2c ± 1) + q dy)): with a = exp(½p(2c − 1) + q dy), the
-        // step right from c is decay / a and the step left from c is a (then each step
-        // multiplies by decay): two `exp` a row.
-        let a = (0.5 * p * (2 * c - 1) as f64 + q * dy).exp();
-        let w_c = self.norm * (-0.5 * e_at(c as f64)).exp();
-        // Rightwards from the peak c.
-        let (mut e, mut wgt) = (e_at(c as f64), w_c);
-        let mut ratio = decay / a;
-        for dx in c..=hi {
-            if e > cut || wgt == 0.0 {
-                break;
-            }
-            add(&mut row[(x as i64 + dx) as usize], wgt);
-            e += p * (2 * dx + 1) as f64 + 2.0 * q * dy;
-            wgt *= ratio;
-            ratio *= decay;
+        let mut w = [0.0; 4];
+        w[0] = self.norm * (-0.5 * e_at(a)).exp();
+        let step = (-0.5 * (p * (2 * a + 1) as f64 + 2.0 * q * dy)).exp();
+        let mut st = step;
+        for j in 1..4 {
+            w[j] = w[j - 1] * st;
+            st *= decay;
         }
-        // Leftwards from c − 1.
-        if c > lo {
-            let d = c - 1;
-            let (mut e, mut wgt) = (e_at(d as f64), w_c * a);
-            let mut ratio = a * decay;
-            for dx in (lo..=d).rev() {
-                if e > cut || wgt == 0.0 {
-                    break;
-                }
-                add(&mut row[(x as i64 + dx) as usize], wgt);
-                e -= p * (2 * dx - 1) as f64 + 2.0 * q * dy;
-                wgt *= ratio;
-                ratio *= decay;
+        let d2 = decay * decay;
+        let d4 = d2 * d2;
+        let mut ratio = [step * step * step * step * d4 * d2; 4];
+        for j in 1..4 {
+            ratio[j] = ratio[j - 1] * d4;
+        }
+        let d16 = d4 * d4 * d4 * d4;
+        let start = out.len();
+        out.resize(start + n.next_multiple_of(4), 0.0);
+        for chunk in out[start..].chunks_exact_mut(4) {
+            for j in 0..4 {
+                chunk[j] = w[j];
+                w[j] *= ratio[j];
+                ratio[j] *= d16;
             }
         }
+        out.truncate(start + n);
+        a
     }
 
     /// The filter's weight at offset `(dx, dy)` px (0 beyond [`CUTOFF`] std).
@@ -262,6 +285,41 @@ impl Filter {
             Filter::Fixed(g) => Some(g),
             Filter::PerPixel(v) => v.get(i),
         }
+    }
+}
+
+/// A filter's weights over its whole support, row by row, so that neighbouring pixels
+/// with the same filter (a block of the covariance grid shares one) compute them once.
+#[derive(Default)]
+struct Stencil {
+    /// The filter the weights are of.
+    of: Option<Gaussian>,
+    /// Its reach in rows and columns (px).
+    reach: usize,
+    /// Per row `dy = −reach ..= reach`: the first column offset and the row's range in
+    /// `weights`.
+    rows: Vec<(i64, Range<usize>)>,
+    /// The weights, row after row.
+    weights: Vec<f64>,
+}
+
+impl Stencil {
+    /// Makes this the stencil of `g` (nothing to do if it already is).
+    fn set(&mut self, g: &Gaussian) {
+        if self.of.as_ref() == Some(g) {
+            return;
+        }
+        let r = (CUTOFF * g.std_max).ceil() as usize;
+        self.rows.clear();
+        self.weights.clear();
+        let ri = r as i64;
+        for dy in -ri..=ri {
+            let k = self.weights.len();
+            let first = g.row_weights(dy as f64, -ri, ri, &mut self.weights);
+            self.rows.push((first, k..self.weights.len()));
+        }
+        self.of = Some(*g);
+        self.reach = r;
     }
 }
 
@@ -386,9 +444,26 @@ impl Film {
     /// sample count (the two sums whose ratio [`Film::image`] takes); zero for
     /// [`Filter::Box`] pixels, which splat nothing.
     pub fn splat(&self, filter: &Filter) -> Vec<(DVec3, f64)> {
+        self.splat_values(filter, |i| {
+            let s = self.reflected[i];
+            [s.x, s.y, s.z, f64::from(self.count[i])]
+        })
+        .into_iter()
+        .map(|v| (DVec3::new(v[0], v[1], v[2]), v[3]))
+        .collect()
+    }
+
+    /// Per pixel, the sums of `values` of the pixels with samples, each splatted with its
+    /// pixel's filter ([`Film::splat`] splats the reflected radiance and the count; the
+    /// guard's allocation splats luminance and count alone, at half the cost).
+    pub fn splat_values<const K: usize>(
+        &self,
+        filter: &Filter,
+        values: impl Fn(usize) -> [f64; K] + Sync,
+    ) -> Vec<[f64; K]> {
         let (w, h) = (self.width as usize, self.height as usize);
         // Each band of rows splats into a buffer with a margin as deep as its filters reach.
-        let bands: Vec<(usize, Vec<(DVec3, f64)>)> = (0..h.div_ceil(BAND))
+        let bands: Vec<(usize, Vec<[f64; K]>)> = (0..h.div_ceil(BAND))
             .into_par_iter()
             .map(|b| {
                 let (y0, y1) = (b * BAND, ((b + 1) * BAND).min(h));
@@ -399,34 +474,43 @@ impl Film {
                     .unwrap_or(0);
                 let top = y0.saturating_sub(reach);
                 let bottom = (y1 + reach).min(h);
-                let mut buf = vec![(DVec3::ZERO, 0.0); (bottom - top) * w];
+                let mut buf = vec![[0.0f64; K]; (bottom - top) * w];
+                let mut st = Stencil::default();
                 for y in y0..y1 {
                     for x in 0..w {
                         let i = y * w + x;
-                        let (n, s) = (f64::from(self.count[i]), self.reflected[i]);
                         let Some(g) = filter.at(i) else { continue };
-                        if n == 0.0 {
+                        if self.count[i] == 0 {
                             continue;
                         }
-                        let r = (CUTOFF * g.std_max).ceil() as usize;
+                        let v = values(i);
+                        st.set(g);
+                        let r = st.reach;
                         for py in y.saturating_sub(r)..(y + r + 1).min(h) {
+                            let (first, ref k) = st.rows[py + r - y];
+                            // The row's run, clipped to the image's columns.
+                            let c0 = (x as i64 + first).max(0) as usize;
+                            let skip = c0 as i64 - (x as i64 + first);
+                            let wts = &st.weights[(k.start + skip as usize).min(k.end)..k.end];
                             let row = &mut buf[(py - top) * w..(py - top + 1) * w];
-                            g.splat_row(row, x, py as f64 - y as f64, r, |e, wgt| {
-                                e.0 += s * wgt;
-                                e.1 += n * wgt;
-                            });
+                            for (e, &wgt) in row[c0.min(w)..].iter_mut().zip(wts) {
+                                for j in 0..K {
+                                    e[j] += v[j] * wgt;
+                                }
+                            }
                         }
                     }
                 }
                 (top, buf)
             })
             .collect();
-        let mut acc = vec![(DVec3::ZERO, 0.0); w * h];
+        let mut acc = vec![[0.0; K]; w * h];
         for (top, buf) in bands {
             for (k, v) in buf.into_iter().enumerate() {
                 let e = &mut acc[top * w + k];
-                e.0 += v.0;
-                e.1 += v.1;
+                for j in 0..K {
+                    e[j] += v[j];
+                }
             }
         }
         acc
@@ -592,33 +676,37 @@ mod tests {
         assert_eq!(Gaussian::from_cov([f64::NAN, 0.0, 1.0]), Gaussian::isotropic(0.0));
     }
 
-    /// The row walk gives the weights `weight` gives, cell by cell, and no others.
+    /// The row weights are the weights `weight` gives, cell by cell, and no others,
+    /// whatever the clipping.
     #[test]
-    fn row_walk_matches_the_weights() {
+    fn row_weights_match_the_weights() {
         for c in [
             [4.0, 1.5, 2.0],
             [9.0, -2.9, 1.0],
             [0.09, 0.0, 0.09],
             [200.0, 0.0, 0.2],
+            [256.0, 255.0, 256.0],
         ] {
             let g = Gaussian::from_cov(c);
-            let r = (CUTOFF * g.std_max()).ceil() as usize;
-            for x in [0usize, 3, r, 40] {
-                for dy in -(r as i64)..=(r as i64) {
-                    let mut row = vec![0.0; 50];
-                    g.splat_row(&mut row, x, dy as f64, r, |e, w| *e += w);
-                    for (k, v) in row.iter().enumerate() {
-                        let dx = k as f64 - x as f64;
-                        let want = if dx.abs() <= r as f64 {
-                            g.weight(dx, dy as f64)
+            let r = (CUTOFF * g.std_max()).ceil() as i64;
+            for (lo, hi) in [(-r, r), (-3, r), (-r, 0), (2, 5), (-r, -r)] {
+                for dy in -r..=r {
+                    let mut out = vec![7.0];
+                    let first = g.row_weights(dy as f64, lo, hi, &mut out);
+                    for dx in lo..=hi {
+                        let want = g.weight(dx as f64, dy as f64);
+                        let k = dx - first;
+                        let got = if k >= 0 && (k as usize) + 1 < out.len() {
+                            out[k as usize + 1]
                         } else {
                             0.0
                         };
                         assert!(
-                            (v - want).abs() <= 1e-12 * g.norm,
-                            "{c:?} x {x} dy {dy} cell {k}: {v} vs {want}"
+                            (got - want).abs() <= 1e-12 * g.norm,
+                            "{c:?} [{lo}, {hi}] dy {dy} dx {dx}: {got} vs {want}"
                         );
                     }
+                    assert!(out.len() <= (hi - lo + 2).max(1) as usize && out[0] == 7.0);
                 }
             }
         }

@@ -57,9 +57,6 @@ pub struct Guarded {
     pub filters: Vec<Option<Gaussian>>,
 }
 
-/// A candidate's filters, and its splatted sums per pixel ([`Film::splat`]).
-type Candidate<'a> = (&'a [Gaussian], Vec<(DVec3, f64)>);
-
 /// The per-pixel filters of every candidate but the box, in the order of [`SCALES`]
 /// ([`candidate`]). They depend on the guide alone, so a render makes them once.
 /// Only the pixels of `rows` are kept off the edges ([`edge_clamp`]).
@@ -81,27 +78,85 @@ pub fn candidate(guide: &Guide, scale: f64, rows: Range<u32>) -> Vec<Gaussian> {
     edge_clamp(guide.width, guide.height, &raw, rows)
 }
 
-/// Reconstructs `film`'s reflected light with the guard (module docs). With `target`
-/// samples per pixel above a pixel's count (a pilot deciding where the rest of the budget
-/// goes), the choice is the one the guard would make at `target` samples: the variance
-/// terms shrink to `n/target` of the pilot's, while all of the cross-validation residual
-/// above the noise is taken for bias, which more samples do not remove (the conservative
-/// reading: a pilot's noise must not hide detail the full budget will show).
+/// Reconstructs `film`'s reflected light with the guard (module docs).
 ///
 /// `candidates` are [`candidates`] of the film's guide. Only the pixels of `rows` are
 /// estimated and chosen (a part of a render, the `parts` module); the others take the box.
-pub fn guarded(candidates: &[Vec<Gaussian>], film: &Film, target: f64, rows: Range<u32>) -> Guarded {
+pub fn guarded(candidates: &[Vec<Gaussian>], film: &Film, rows: Range<u32>) -> Guarded {
+    let sums: Vec<Vec<(DVec3, f64)>> = candidates
+        .iter()
+        .map(|f| film.splat(&Filter::PerPixel(f.clone())))
+        .collect();
+    let lum: Vec<Vec<[f64; 2]>> = sums
+        .iter()
+        .map(|acc| acc.iter().map(|&(s, n)| [luminance(s), n]).collect())
+        .collect();
+    let choice = choose(&lum, candidates, film, 0.0, &rows);
+    let reflected = (0..film.count.len())
+        .map(|p| match sums.get(choice[p] as usize) {
+            Some(acc) if acc[p].1 > 0.0 => acc[p].0 / acc[p].1,
+            _ => match film.count[p] {
+                0 => DVec3::ZERO,
+                c => film.reflected[p] / f64::from(c),
+            },
+        })
+        .collect();
+    Guarded {
+        reflected,
+        filters: filters_of(&choice, candidates),
+    }
+}
+
+/// The filters the guard would choose at `target` samples per pixel, from a film with
+/// fewer (a pilot deciding where the rest of the budget goes): the variance terms shrink
+/// to `n/target` of the pilot's, while all of the cross-validation residual above the
+/// noise is taken for bias, which more samples do not remove (the conservative reading: a
+/// pilot's noise must not hide detail the full budget will show). Only luminance is
+/// splatted, which is all the choice reads. `None`: the box.
+pub fn chosen_filters(
+    candidates: &[Vec<Gaussian>],
+    film: &Film,
+    target: f64,
+    rows: Range<u32>,
+) -> Vec<Option<Gaussian>> {
+    let lum: Vec<Vec<[f64; 2]>> = candidates
+        .iter()
+        .map(|f| {
+            film.splat_values(&Filter::PerPixel(f.clone()), |i| {
+                [luminance(film.reflected[i]), f64::from(film.count[i])]
+            })
+        })
+        .collect();
+    filters_of(&choose(&lum, candidates, film, target, &rows), candidates)
+}
+
+/// Each pixel's chosen filter (`None`: the box).
+fn filters_of(choice: &[u8], candidates: &[Vec<Gaussian>]) -> Vec<Option<Gaussian>> {
+    (0..choice.len())
+        .map(|p| candidates.get(choice[p] as usize).map(|f| f[p]))
+        .collect()
+}
+
+/// Per pixel, the index of the candidate of least estimated error (module docs;
+/// `candidates.len()`: the box), given each candidate's splatted luminance and weight
+/// (`lum`), at `target` samples per pixel (0: the film's own counts).
+fn choose(
+    lum: &[Vec<[f64; 2]>],
+    candidates: &[Vec<Gaussian>],
+    film: &Film,
+    target: f64,
+    rows: &Range<u32>,
+) -> Vec<u8> {
     let (w, h) = (film.width as i64, film.height as i64);
     let inside = |p: usize| rows.contains(&((p as i64 / w.max(1)) as u32));
     let n = film.count.len();
     let var = film.variance();
-    let x: Vec<DVec3> = (0..n)
+    let lx: Vec<f64> = (0..n)
         .map(|i| match film.count[i] {
-            0 => DVec3::ZERO,
-            c => film.reflected[i] / f64::from(c),
+            0 => 0.0,
+            c => luminance(film.reflected[i] / f64::from(c)),
         })
         .collect();
-    let lx: Vec<f64> = x.iter().map(|&v| luminance(v)).collect();
     let s2: Vec<f64> = (0..n).map(|i| var[i] / f64::from(film.count[i].max(1))).collect();
     // The variance of the pixel's mean at the target count.
     let s2_target: Vec<f64> = (0..n)
@@ -111,16 +166,14 @@ pub fn guarded(candidates: &[Vec<Gaussian>], film: &Film, target: f64, rows: Ran
         })
         .collect();
     // The normaliser of the relative error: the squared 3×3 mean luminance.
-    let norm: Vec<f64> = box3(w, h, &lx, &rows).iter().map(|m| m * m + REL_EPS).collect();
+    let norm: Vec<f64> = box3(w, h, &lx, rows).iter().map(|m| m * m + REL_EPS).collect();
     let mut risks: Vec<Vec<f64>> = Vec::with_capacity(candidates.len() + 1);
-    let mut images: Vec<Candidate<'_>> = Vec::with_capacity(candidates.len());
-    for filters in candidates {
-        let acc = film.splat(&Filter::PerPixel(filters.clone()));
+    for (filters, acc) in candidates.iter().zip(lum) {
         let risk: Vec<f64> = (0..n)
             .into_par_iter()
             .map(|p| {
                 let c = f64::from(film.count[p]);
-                let (sum, wsum) = acc[p];
+                let [sum, wsum] = acc[p];
                 if c == 0.0 || wsum <= 0.0 || !inside(p) {
                     return f64::INFINITY;
                 }
@@ -130,41 +183,30 @@ pub fn guarded(candidates: &[Vec<Gaussian>], film: &Film, target: f64, rows: Ran
                 if loo_w <= 1e-9 * wsum {
                     return s2_target[p] / norm[p];
                 }
-                let loo = luminance(sum - film.reflected[p] * own) / loo_w;
+                let loo = (sum - luminance(film.reflected[p]) * own) / loo_w;
                 let cv = (loo - lx[p]).powi(2);
                 (alpha * alpha * s2_target[p] + (1.0 - alpha).powi(2) * (cv - s2[p]).max(0.0)) / norm[p]
             })
             .collect();
-        risks.push(box3(w, h, &risk, &rows));
-        images.push((filters.as_slice(), acc));
+        risks.push(box3(w, h, &risk, rows));
     }
     risks.push(box3(
         w,
         h,
         &(0..n).map(|p| s2_target[p] / norm[p]).collect::<Vec<_>>(),
-        &rows,
+        rows,
     ));
-    let choice: Vec<u8> = (0..n)
+    (0..n)
         .map(|p| {
-            let mut best = SCALES.len();
-            for k in (0..SCALES.len()).filter(|_| inside(p)) {
+            let mut best = candidates.len();
+            for k in (0..candidates.len()).filter(|_| inside(p)) {
                 if risks[k][p] < risks[best][p] {
                     best = k;
                 }
             }
             best as u8
         })
-        .collect();
-    let reflected = (0..n)
-        .map(|p| match images.get(choice[p] as usize) {
-            Some((_, acc)) if acc[p].1 > 0.0 => acc[p].0 / acc[p].1,
-            _ => x[p],
-        })
-        .collect();
-    let filters = (0..n)
-        .map(|p| images.get(choice[p] as usize).map(|(f, _)| f[p]))
-        .collect();
-    Guarded { reflected, filters }
+        .collect()
 }
 
 /// The 3×3 mean of `v` in `rows` (fewer pixels at the borders; an infinite value stays

@@ -44,7 +44,7 @@ use crate::adaptive::{Guide, MAX_RATIO, allocate_floors, filter_area, relative_v
 use crate::covpass::{CovMaps, MAX_COV_PATHS, STRIDES, covariance_rows};
 use crate::denoise::Denoise;
 use crate::film::{Film, Filter, Gaussian, Image, MAX_SPP, Progress};
-use crate::guard::{candidate, candidates, guarded};
+use crate::guard::{candidate, candidates, chosen_filters, guarded};
 use crate::world::World;
 
 /// Std of the fixed Gaussian filter of the `gauss` baseline (px).
@@ -495,9 +495,9 @@ impl<'w> Renderer<'w> {
                     vec![lo; n],
                 ),
                 (Method::Cov, Some(_)) => {
-                    let gd = guarded(&cands, film, s.spp, win.pilot.clone());
+                    let chosen = chosen_filters(&cands, film, s.spp, win.pilot.clone());
                     let keep = (s.spp.floor() as u32).max(lo);
-                    gd.filters
+                    chosen
                         .iter()
                         .zip(&rv)
                         .map(|(f, r)| match f {
@@ -694,7 +694,7 @@ pub(crate) fn reconstruct(
     let n = film.count.len();
     let (image, secs) = timed(|| match (method, guide) {
         (Method::Cov, Some(_)) => {
-            let gd = guarded(cands, film, 0.0, 0..h);
+            let gd = guarded(cands, film, 0..h);
             let pixels = (0..n)
                 .map(|i| match film.count[i] {
                     0 => DVec3::ZERO,
