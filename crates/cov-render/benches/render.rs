@@ -1,10 +1,14 @@
 //! Renderer speed: primary rays per second (camera ray, BVH hit, shading with one light
 //! sample and one bounce) and covariance paths per second, on the bundled scenes at a
-//! small size. Run: `cargo bench -p cov-render --bench render`; compare within one run.
+//! small size; and the guard's stages against the path tracing they serve. Run:
+//! `cargo bench -p cov-render --bench render`; compare within one run.
 
 use std::hint::black_box;
 use std::path::Path;
 
+use cov_render::adaptive::Guide;
+use cov_render::film::Film;
+use cov_render::guard::{candidates, chosen_filters, guarded};
 use cov_render::{World, covariance_maps, render};
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 
@@ -35,5 +39,47 @@ fn scenes(c: &mut Criterion) {
     }
 }
 
-criterion_group!(benches, scenes);
+/// The guard's stages at the renderer's defaults (one covariance path per 4×4 block), on
+/// a film of 4 samples per pixel (a 16-spp render's pilot), one thread, beside the path
+/// tracing of those 4 samples: what the guard costs relative to the sampling it directs.
+fn guard(c: &mut Criterion) {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/scenes");
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(1)
+        .build()
+        .expect("pool");
+    let (w, h) = (128, 96);
+    for name in ["cornell", "chess"] {
+        let world = World::load(&dir.join(format!("{name}.ron")))
+            .expect("bundled scene")
+            .with_resolution(w, h);
+        let maps = covariance_maps(&world, 1, 4, 1, None).expect("maps");
+        let guide = Guide::new(&maps, 0.0);
+        let counts = vec![4; (w * h) as usize];
+        let sample = || {
+            let mut film = Film::new(w, h);
+            film.render(&world, &counts, 1, f64::INFINITY, None);
+            film
+        };
+        let film = pool.install(sample);
+        let cands = candidates(&guide, 0..h);
+        let mut g = c.benchmark_group(format!("guard/{name}"));
+        g.sample_size(10);
+        g.bench_function("path tracing, 4 spp", |b| {
+            b.iter(|| pool.install(|| black_box(sample())))
+        });
+        g.bench_function("candidates (3 scales, edge clamp)", |b| {
+            b.iter(|| pool.install(|| black_box(candidates(&guide, 0..h))))
+        });
+        g.bench_function("pilot choice (luminance splats)", |b| {
+            b.iter(|| pool.install(|| black_box(chosen_filters(&cands, &film, 16.0, 0..h))))
+        });
+        g.bench_function("reconstruction (colour splats)", |b| {
+            b.iter(|| pool.install(|| black_box(guarded(&cands, &film, 0..h))))
+        });
+        g.finish();
+    }
+}
+
+criterion_group!(benches, scenes, guard);
 criterion_main!(benches);

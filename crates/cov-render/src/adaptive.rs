@@ -128,6 +128,15 @@ fn around(w: i64, h: i64, i: i64, r: i64) -> impl Iterator<Item = (usize, i64)> 
     })
 }
 
+/// The pixels at Chebyshev distance `rho` ≥ 1 from `(x, y)` (unclipped).
+fn ring(x: i64, y: i64, rho: i64) -> impl Iterator<Item = (i64, i64)> {
+    let top = (-rho..=rho).map(move |d| (x + d, y - rho));
+    let bottom = (-rho..=rho).map(move |d| (x + d, y + rho));
+    let left = (1 - rho..rho).map(move |d| (x - rho, y + d));
+    let right = (1 - rho..rho).map(move |d| (x + rho, y + d));
+    top.chain(bottom).chain(left).chain(right)
+}
+
 /// Narrows every filter so that it does not reach, at [`EDGE_REACH`] of its own std, a
 /// pixel whose filter is narrower than the distance to it over [`EDGE_REACH`]: a wide
 /// filter stops short of an edge the covariance pass saw a few pixels away.
@@ -139,16 +148,6 @@ pub fn edge_clamp(width: u32, height: u32, raw: &[Gaussian], rows: Range<u32>) -
     let (w, h) = (i64::from(width), i64::from(height));
     let stds: Vec<f64> = raw.iter().map(Gaussian::std_max).collect();
     let (r0, r1) = (i64::from(rows.start) * w, i64::from(rows.end.min(height)) * w);
-    // The smallest std of each `CELL × CELL` cell: a whole cell is skipped when none of
-    // its pixels can lower a pixel's limit (in a smooth region, none can).
-    const CELL: i64 = 8;
-    let (cw, ch) = ((w + CELL - 1) / CELL, (h + CELL - 1) / CELL);
-    let mut cell_min = vec![f64::INFINITY; (cw * ch) as usize];
-    for (i, &sk) in stds.iter().enumerate() {
-        let (x, y) = (i as i64 % w, i as i64 / w);
-        let c = &mut cell_min[((y / CELL) * cw + x / CELL) as usize];
-        *c = c.min(sk);
-    }
     (0..w * h)
         .into_par_iter()
         .map(|i| {
@@ -158,71 +157,31 @@ pub fn edge_clamp(width: u32, height: u32, raw: &[Gaussian], rows: Range<u32>) -
             }
             let s = g.std_max();
             let mut limit = s;
-            // A pixel `d` away lowers the limit to max(its std, d / EDGE_REACH) if that is
-            // less; beyond EDGE_REACH · s none can.
+            // Rings of growing Chebyshev radius ρ: a pixel on ring ρ is at least ρ away, so
+            // it cannot bring the limit below ρ / EDGE_REACH; once that is the limit, stop.
             let (x, y) = (i % w, i / w);
             let r = (EDGE_REACH * s).ceil() as i64;
-            let lower = |xx: i64, yy: i64, limit: &mut f64| {
-                let sk = stds[(yy * w + xx) as usize];
-                if sk < *limit {
-                    let d = (((xx - x).pow(2) + (yy - y).pow(2)) as f64).sqrt();
-                    *limit = limit.min(sk.max(d / EDGE_REACH));
+            for rho in 1..=r {
+                if rho as f64 / EDGE_REACH >= limit {
+                    break;
                 }
-            };
-            // First the square of side 2 NEAR + 1, nearest rows first: where an edge is
-            // close, the limit falls to NEAR / EDGE_REACH or below and nothing farther
-            // can lower it.
-            const NEAR: i64 = 4;
-            let near = NEAR.min(r);
-            for dy in std::iter::once(0).chain((1..=near).flat_map(|d| [-d, d])) {
-                let yy = y + dy;
-                if yy < 0 || yy >= h {
-                    continue;
-                }
-                for xx in (x - near).max(0)..=(x + near).min(w - 1) {
-                    lower(xx, yy, &mut limit);
-                }
-            }
-            if r <= near || near as f64 / EDGE_REACH >= limit {
-                return narrowed(g, limit);
-            }
-            let (cx0, cx1) = ((x - r).max(0) / CELL, (x + r).min(w - 1) / CELL);
-            let (cy0, cy1) = ((y - r).max(0) / CELL, (y + r).min(h - 1) / CELL);
-            for cy in cy0..=cy1 {
-                for cx in cx0..=cx1 {
-                    if cell_min[(cy * cw + cx) as usize] >= limit {
-                        continue;
-                    }
-                    // The cell's nearest point to the pixel bounds its pixels' distances.
-                    let (x0, y0) = (cx * CELL, cy * CELL);
-                    let (x1, y1) = ((x0 + CELL - 1).min(w - 1), (y0 + CELL - 1).min(h - 1));
-                    let gx = (x0 - x).max(x - x1).max(0);
-                    let gy = (y0 - y).max(y - y1).max(0);
-                    if ((gx * gx + gy * gy) as f64).sqrt() / EDGE_REACH >= limit {
-                        continue;
-                    }
-                    for yy in y0..=y1 {
-                        for xx in x0..=x1 {
-                            lower(xx, yy, &mut limit);
-                        }
+                for (xx, yy) in ring(x, y, rho).filter(|&(xx, yy)| xx >= 0 && yy >= 0 && xx < w && yy < h) {
+                    let sk = stds[(yy * w + xx) as usize];
+                    if sk < limit {
+                        let d = (((xx - x).pow(2) + (yy - y).pow(2)) as f64).sqrt();
+                        limit = limit.min(sk.max(d / EDGE_REACH));
                     }
                 }
             }
-            narrowed(g, limit)
+            if limit < s {
+                let k = (limit / s).powi(2);
+                let c = g.cov();
+                Gaussian::from_cov([c[0] * k, c[1] * k, c[2] * k])
+            } else {
+                g
+            }
         })
         .collect()
-}
-
-/// `g` scaled so that its larger std is `limit`, if that is smaller.
-fn narrowed(g: Gaussian, limit: f64) -> Gaussian {
-    let s = g.std_max();
-    if limit < s {
-        let k = (limit / s).powi(2);
-        let c = g.cov();
-        Gaussian::from_cov([c[0] * k, c[1] * k, c[2] * k])
-    } else {
-        g
-    }
 }
 
 /// The covariance pass's products a method uses: sample weights and matched filters.

@@ -244,8 +244,8 @@ impl Gaussian {
         let start = out.len();
         out.resize(start + n.next_multiple_of(4), 0.0);
         for chunk in out[start..].chunks_exact_mut(4) {
+            chunk.copy_from_slice(&w);
             for j in 0..4 {
-                chunk[j] = w[j];
                 w[j] *= ratio[j];
                 ratio[j] *= d16;
             }
