@@ -15,16 +15,26 @@ use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 const W: u32 = 64;
 const H: u32 = 48;
 
-fn scenes(c: &mut Criterion) {
+/// A bundled scene at `w × h`.
+fn scene(name: &str, w: u32, h: u32) -> World {
     let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/scenes");
-    let pool = rayon::ThreadPoolBuilder::new()
+    World::load(&dir.join(format!("{name}.ron")))
+        .expect("bundled scene")
+        .with_resolution(w, h)
+}
+
+/// A pool of one thread: the figures are per core.
+fn one_thread() -> rayon::ThreadPool {
+    rayon::ThreadPoolBuilder::new()
         .num_threads(1)
         .build()
-        .expect("pool");
+        .expect("pool")
+}
+
+fn scenes(c: &mut Criterion) {
+    let pool = one_thread();
     for name in ["cornell", "pool", "glossy"] {
-        let world = World::load(&dir.join(format!("{name}.ron")))
-            .expect("bundled scene")
-            .with_resolution(W, H);
+        let world = scene(name, W, H);
         let mut g = c.benchmark_group(format!("render/{name}"));
         g.sample_size(10);
         g.throughput(Throughput::Elements((W * H) as u64));
@@ -43,16 +53,10 @@ fn scenes(c: &mut Criterion) {
 /// a film of 4 samples per pixel (a 16-spp render's pilot), one thread, beside the path
 /// tracing of those 4 samples: what the guard costs relative to the sampling it directs.
 fn guard(c: &mut Criterion) {
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/scenes");
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(1)
-        .build()
-        .expect("pool");
+    let pool = one_thread();
     let (w, h) = (128, 96);
     for name in ["cornell", "chess"] {
-        let world = World::load(&dir.join(format!("{name}.ron")))
-            .expect("bundled scene")
-            .with_resolution(w, h);
+        let world = scene(name, w, h);
         let maps = covariance_maps(&world, 1, 4, 1, None).expect("maps");
         let guide = Guide::new(&maps, 0.0);
         let counts = vec![4; (w * h) as usize];
