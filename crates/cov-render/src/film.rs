@@ -676,6 +676,53 @@ mod tests {
         assert_eq!(Gaussian::from_cov([f64::NAN, 0.0, 1.0]), Gaussian::isotropic(0.0));
     }
 
+    /// A splat is the sum, over the pixels with samples, of their sums weighted by their
+    /// filter at each cell: against that sum taken cell by cell with [`Gaussian::weight`],
+    /// on an image of several bands, with filters wider than the image (clipped at every
+    /// border), runs of pixels sharing a filter (the stencil reused) and empty pixels.
+    #[test]
+    fn splat_is_the_weighted_sum() {
+        let (w, h) = (23u32, 37u32);
+        let n = (w * h) as usize;
+        let mut seed = 0x2545_f491_4f6c_dd1du64;
+        let mut rnd = move || {
+            seed ^= seed << 13;
+            seed ^= seed >> 7;
+            seed ^= seed << 17;
+            (seed >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let mut film = Film::new(w, h);
+        for i in 0..n {
+            film.count[i] = if rnd() < 0.1 { 0 } else { 1 + (rnd() * 8.0) as u32 };
+            film.reflected[i] = DVec3::new(rnd(), rnd(), rnd()) * f64::from(film.count[i]);
+        }
+        let mut filters = Vec::with_capacity(n);
+        while filters.len() < n {
+            let s = 0.2 + 20.0 * rnd() * rnd();
+            let g = Gaussian::from_cov([s * s, (rnd() - 0.5) * s * s, s * s * (0.2 + rnd())]);
+            let run = 1 + (rnd() * 6.0) as usize;
+            filters.extend(std::iter::repeat_n(g, run.min(n - filters.len())));
+        }
+        for filter in [Filter::PerPixel(filters), Filter::Fixed(Gaussian::isotropic(2.5))] {
+            let got = film.splat(&filter);
+            for p in 0..n {
+                let (px, py) = ((p % w as usize) as f64, (p / w as usize) as f64);
+                let (mut s, mut c) = (DVec3::ZERO, 0.0);
+                for q in (0..n).filter(|&q| film.count[q] > 0) {
+                    let g = filter.at(q).expect("a filter");
+                    let (qx, qy) = ((q % w as usize) as f64, (q / w as usize) as f64);
+                    let wq = g.weight(px - qx, py - qy);
+                    s += film.reflected[q] * wq;
+                    c += f64::from(film.count[q]) * wq;
+                }
+                let (gs, gc) = got[p];
+                let tol = 1e-12 * (1.0 + c);
+                assert!((gc - c).abs() <= tol, "pixel {p}: weight {gc} vs {c}");
+                assert!((gs - s).abs().max_element() <= tol, "pixel {p}: {gs} vs {s}");
+            }
+        }
+    }
+
     /// The row weights are the weights `weight` gives, cell by cell, and no others,
     /// whatever the clipping.
     #[test]
