@@ -72,7 +72,9 @@ pub enum Method {
     /// Covariance tracing: a pilot; the guard ([`crate::guard`]) checks the covariance
     /// filters against the pilot's samples; samples ∝ the relative standard deviation
     /// over the square root of the pixels the guarded filter averages; the guarded
-    /// reconstruction.
+    /// reconstruction. Followed by a denoiser, the denoiser receives the box image
+    /// instead: the guard then decides where samples go, the denoiser how they are
+    /// reconstructed (a Σ-filtered input measured worse, docs/oidn.md).
     Cov,
 }
 
@@ -692,8 +694,10 @@ pub(crate) fn reconstruct(
 ) -> Result<Image, RenderError> {
     let (w, h) = (film.width, film.height);
     let n = film.count.len();
+    // A denoiser reconstructs the covariance method's samples itself, from the box image.
+    let guarded_image = denoise == Denoise::None;
     let (image, secs) = timed(|| match (method, guide) {
-        (Method::Cov, Some(_)) => {
+        (Method::Cov, Some(_)) if guarded_image => {
             let gd = guarded(cands, film, 0..h);
             let pixels = (0..n)
                 .map(|i| match film.count[i] {

@@ -151,3 +151,27 @@ fn oidn_lowers_the_error_of_a_noisy_render() {
         "noisy {noisy}, guided {guided}, colour {color}"
     );
 }
+
+/// With OIDN, covariance tracing gives the denoiser its box image: the guarded allocation
+/// decides where samples go, the denoiser reconstructs them. The render equals OIDN run
+/// on the box image of the same samples, and its samples are those of `cov` alone.
+#[cfg(feature = "oidn")]
+#[test]
+fn the_denoiser_receives_the_box_image_of_the_guarded_samples() {
+    let world = cornell(64, 48);
+    let run = |d: Denoise| {
+        let s = RenderSettings {
+            method: Method::Cov,
+            spp: 8.0,
+            denoise: d,
+            ..RenderSettings::default()
+        };
+        Renderer::new(&world, s).unwrap().render(None).unwrap()
+    };
+    let (plain, denoised) = (run(Denoise::None), run(Denoise::Oidn));
+    assert_eq!(plain.film, denoised.film);
+    let aovs = plain.film.aovs();
+    let want = cov_render::denoise::oidn(&plain.film.box_image(), Some(&aovs)).unwrap();
+    assert_eq!(denoised.image.digest(), want.digest());
+    assert_ne!(denoised.image.digest(), plain.image.digest());
+}
