@@ -300,13 +300,9 @@ mod tests {
     #[test]
     fn edge_clamp_is_its_definition() {
         let (w, h) = (37u32, 29u32);
-        let mut seed = 0x9e37_79b9_7f4a_7c15u64;
-        let mut rnd = move || {
-            seed ^= seed << 13;
-            seed ^= seed >> 7;
-            seed ^= seed << 17;
-            (seed >> 11) as f64 / (1u64 << 53) as f64
-        };
+        use rand::{Rng, SeedableRng};
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(7);
+        let mut rnd = move || rng.random::<f64>();
         for field in 0..6 {
             let raw: Vec<Gaussian> = (0..w * h)
                 .map(|i| {

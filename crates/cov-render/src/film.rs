@@ -684,13 +684,9 @@ mod tests {
     fn splat_is_the_weighted_sum() {
         let (w, h) = (23u32, 37u32);
         let n = (w * h) as usize;
-        let mut seed = 0x2545_f491_4f6c_dd1du64;
-        let mut rnd = move || {
-            seed ^= seed << 13;
-            seed ^= seed >> 7;
-            seed ^= seed << 17;
-            (seed >> 11) as f64 / (1u64 << 53) as f64
-        };
+        use rand::{Rng, SeedableRng};
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(11);
+        let mut rnd = move || rng.random::<f64>();
         let mut film = Film::new(w, h);
         for i in 0..n {
             film.count[i] = if rnd() < 0.1 { 0 } else { 1 + (rnd() * 8.0) as u32 };

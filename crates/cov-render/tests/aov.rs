@@ -102,6 +102,18 @@ fn cornell(w: u32, h: u32) -> World {
         .with_resolution(w, h)
 }
 
+/// Renders `world` with `method` at `spp`, followed by `denoise`.
+#[cfg(feature = "oidn")]
+fn render_with(world: &World, method: Method, spp: f64, denoise: Denoise) -> cov_render::Rendered {
+    let s = RenderSettings {
+        method,
+        spp,
+        denoise,
+        ..RenderSettings::default()
+    };
+    Renderer::new(world, s).unwrap().render(None).unwrap()
+}
+
 /// Without the feature, asking for the denoiser is a clear error, never a crash.
 #[cfg(not(feature = "oidn"))]
 #[test]
@@ -130,13 +142,7 @@ fn oidn_lowers_the_error_of_a_noisy_render() {
     let world = cornell(64, 48);
     let reference = cov_render::render(&world, 256, 77);
     let run = |d: Denoise| {
-        let s = RenderSettings {
-            method: Method::Uniform,
-            spp: 4.0,
-            denoise: d,
-            ..RenderSettings::default()
-        };
-        let r = Renderer::new(&world, s).unwrap().render(None).unwrap();
+        let r = render_with(&world, Method::Uniform, 4.0, d);
         assert!(
             r.image
                 .pixels
@@ -159,15 +165,7 @@ fn oidn_lowers_the_error_of_a_noisy_render() {
 #[test]
 fn the_denoiser_receives_the_box_image_of_the_guarded_samples() {
     let world = cornell(64, 48);
-    let run = |d: Denoise| {
-        let s = RenderSettings {
-            method: Method::Cov,
-            spp: 8.0,
-            denoise: d,
-            ..RenderSettings::default()
-        };
-        Renderer::new(&world, s).unwrap().render(None).unwrap()
-    };
+    let run = |d: Denoise| render_with(&world, Method::Cov, 8.0, d);
     let (plain, denoised) = (run(Denoise::None), run(Denoise::Oidn));
     assert_eq!(plain.film, denoised.film);
     let aovs = plain.film.aovs();
