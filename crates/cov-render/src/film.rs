@@ -176,6 +176,12 @@ impl Gaussian {
         self.std_max
     }
 
+    /// How many cells the filter reaches from its centre, along a row or a column:
+    /// `⌈CUTOFF · std_max⌉`.
+    pub fn reach(&self) -> usize {
+        (CUTOFF * self.std_max).ceil() as usize
+    }
+
     /// The covariance `[xx, xy, yy]` (px²).
     pub fn cov(&self) -> [f64; 3] {
         let [p, q, r] = self.precision;
@@ -294,10 +300,8 @@ impl Filter {
 struct Stencil {
     /// The filter the weights are of.
     of: Option<Gaussian>,
-    /// Its reach in rows and columns (px).
-    reach: usize,
-    /// Per row `dy = −reach ..= reach`: the first column offset and the row's range in
-    /// `weights`.
+    /// Per row `dy = −reach ..= reach` ([`Gaussian::reach`]): the first column offset and
+    /// the row's range in `weights`.
     rows: Vec<(i64, Range<usize>)>,
     /// The weights, row after row.
     weights: Vec<f64>,
@@ -309,17 +313,20 @@ impl Stencil {
         if self.of.as_ref() == Some(g) {
             return;
         }
-        let r = (CUTOFF * g.std_max).ceil() as usize;
         self.rows.clear();
         self.weights.clear();
-        let ri = r as i64;
+        let ri = g.reach() as i64;
         for dy in -ri..=ri {
             let k = self.weights.len();
             let first = g.row_weights(dy as f64, -ri, ri, &mut self.weights);
             self.rows.push((first, k..self.weights.len()));
         }
         self.of = Some(*g);
-        self.reach = r;
+    }
+
+    /// The reach of the filter the stencil is of.
+    fn reach(&self) -> usize {
+        self.rows.len() / 2
     }
 }
 
@@ -469,7 +476,7 @@ impl Film {
                 let (y0, y1) = (b * BAND, ((b + 1) * BAND).min(h));
                 let reach = (y0 * w..y1 * w)
                     .filter_map(|i| filter.at(i))
-                    .map(|g| (CUTOFF * g.std_max).ceil() as usize)
+                    .map(Gaussian::reach)
                     .max()
                     .unwrap_or(0);
                 let top = y0.saturating_sub(reach);
@@ -485,7 +492,7 @@ impl Film {
                         }
                         let v = values(i);
                         st.set(g);
-                        let r = st.reach;
+                        let r = st.reach();
                         for py in y.saturating_sub(r)..(y + r + 1).min(h) {
                             let (first, ref k) = st.rows[py + r - y];
                             // The row's run, clipped to the image's columns.
@@ -731,7 +738,7 @@ mod tests {
             [256.0, 255.0, 256.0],
         ] {
             let g = Gaussian::from_cov(c);
-            let r = (CUTOFF * g.std_max()).ceil() as i64;
+            let r = g.reach() as i64;
             for (lo, hi) in [(-r, r), (-3, r), (-r, 0), (2, 5), (-r, -r)] {
                 for dy in -r..=r {
                     let mut out = vec![7.0];
