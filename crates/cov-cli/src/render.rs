@@ -631,6 +631,7 @@ pub fn check(a: &CheckArgs) -> Result<String, String> {
          tiles of {t}×{t} px: {n}, with detail: {}\n\
          predicted / measured bandwidth (median over tiles with detail): {}\n\
          rank correlation (Spearman) over tiles with detail: {}\n\
+         for comparison: predicted against the variation's bandwidth alone (mean removed): {}; the references' own contrast against the measurement: {}\n\
          under-sampled tiles (predicted < half the measured bandwidth): {:.1}% of tiles with detail",
         cov_render::echo(&a.scene.display().to_string()),
         a.ref_spp,
@@ -638,6 +639,8 @@ pub fn check(a: &CheckArgs) -> Result<String, String> {
         agreement.detail_tiles,
         fmt_num(agreement.median_ratio),
         fmt_num(agreement.rank_correlation),
+        fmt_num(agreement.variation_correlation),
+        fmt_num(agreement.contrast_correlation),
         100.0 * agreement.undersampled,
         t = cov_render::validate::T,
     ))

@@ -17,7 +17,8 @@
 //!    outgoing ray), inside `Moving` when the shape moves;
 //! 4. travel to the camera, with a `Moving` `BlockerEdge` where auxiliary camera rays
 //!    around the pixel see a silhouette (a nearer surface or the background) in front of
-//!    or behind the hit: defocus and motion blur of edges;
+//!    or behind the hit, a crease or another material, its window weighed by the step's
+//!    contrast (docs/physics.md section 3): defocus and motion blur of edges;
 //! 5. the camera: its motion, the shutter window, the thin lens (or pinhole), and the
 //!    sensor's sampling rates (`Sensor::rates`).
 //!
@@ -332,7 +333,7 @@ pub fn trace_path<R: Rng>(
     }
     // 4. Travel to the camera, past the nearest silhouette.
     let x_cam = frame_x(d_out, cam.right);
-    match nearest_silhouette(world, &hit, (px, py), block, time, ut) {
+    match nearest_silhouette(world, &hit, (px, py), block, (time, ut), footprint.0) {
         Some(e) => {
             chain.push(Travel::new((hit.t - e.depth).max(0.0))?);
             let edge = Chain::new().with(BlockerEdge::new(e.radius)?);
@@ -417,10 +418,55 @@ pub const CREASE_COS: f64 = 0.906;
 struct Silhouette {
     /// Distance from the camera to the edge's surface (m).
     depth: f64,
-    /// Distance from the path to the edge at that depth (m).
+    /// Distance from the path to the edge at that depth (m), divided by the square root of
+    /// the edge's contrast ([`contrast`]): the `BlockerEdge` whose window is the contrast
+    /// times the full-contrast edge's.
     radius: f64,
     /// Velocity of the nearer surface.
     velocity: DVec3,
+}
+
+/// The luminance a hit sends back along `-d` (towards the camera) from direct light,
+/// ignoring visibility: one deterministic sample at the middle of each light, unshadowed
+/// (shadows are the blockers' business); an emitter's own radiance; 0 for nothing. A
+/// proxy for the radiance on either side of an edge, no ray traced.
+fn direct_proxy(world: &World, hit: Option<&Hit>, d: DVec3, footprint: f64) -> f64 {
+    let Some(h) = hit else { return 0.0 };
+    if let Some(li) = h.light {
+        return if h.front {
+            luminance(world.lights[li as usize].radiance()).max(0.0)
+        } else {
+            0.0
+        };
+    }
+    let mat = world.material_at(h, footprint);
+    let wo = -d;
+    let mut sum = 0.0;
+    for light in &world.lights {
+        if let Some(ls) = light.sample(h.p, 0.5, 0.5) {
+            let cos_i = h.n.dot(ls.wi);
+            if cos_i > 0.0 && ls.pdf > 0.0 {
+                sum += luminance(mat.eval(h.n, wo, ls.wi) * ls.radiance) * cos_i / ls.pdf;
+            }
+        }
+    }
+    if sum.is_finite() { sum.max(0.0) } else { 0.0 }
+}
+
+/// The contrast of a step between radiances `a` and `b` (both ≥ 0), `|a − b| / max(a, b)`:
+/// the step's share of the amplitude spectrum relative to a full-contrast edge (one side
+/// dark), the model of cov-occlusion's `Texture::from_moments` applied to a step
+/// (docs/physics.md section 3, "textures"). A field `b + (a − b)·s(x)` with `s` a unit
+/// step has the amplitude `|a − b|` on the step's spectrum against `min(a, b)` on the
+/// Dirac at zero, so the edge's window is weighed by `|a − b| / (min + |a − b|)`. Both
+/// sides dark (light that only arrives indirectly): 1, the full-contrast edge, as before.
+fn contrast(a: f64, b: f64) -> f64 {
+    let hi = a.max(b);
+    if hi > 0.0 {
+        ((a - b).abs() / hi).min(1.0)
+    } else {
+        1.0
+    }
 }
 
 /// Whether two hits see the same surface: the same material (or two materials with the
@@ -442,17 +488,19 @@ fn same_surface(world: &World, a: &Hit, b: &Hit) -> bool {
 /// shading changes abruptly), another material (a step in reflectance), or an emitter
 /// where the path sees none (the edge of a light) or the reverse. The edge lies at the
 /// nearer surface's depth, half a pixel's footprint from the path there: a block that holds
-/// an edge predicts it for all its pixels.
+/// an edge predicts it for all its pixels. Each edge's window is weighed by its
+/// [`contrast`], from the two sides' [`direct_proxy`]; the strongest window wins.
 fn nearest_silhouette(
     world: &World,
     hit: &Hit,
     (px, py): (f64, f64),
     block: Block,
-    time: f64,
-    ut: f64,
+    (time, ut): (f64, f64),
+    footprint: f64,
 ) -> Option<Silhouette> {
     let cam = &world.camera;
     let mut best: Option<Silhouette> = None;
+    let mut here: Option<f64> = None;
     let around = [(0.5, 0.0), (-0.5, 0.0), (0.0, 0.5), (0.0, -0.5)];
     let [x0, y0, x1, y1] = block;
     let corners = [
@@ -486,8 +534,13 @@ fn nearest_silhouette(
             ),
             None => (hit.t, hit.velocity),
         };
-        // Half a pixel's footprint at that depth.
-        let radius = (cam.tan_x * depth / cam.width as f64).max(1e-9);
+        let l_here = *here.get_or_insert_with(|| direct_proxy(world, Some(hit), r.dir, footprint));
+        let c = contrast(l_here, direct_proxy(world, h.as_ref(), r.dir, footprint));
+        if c <= 0.0 {
+            continue;
+        }
+        // Half a pixel's footprint at that depth, its window weighed by the contrast.
+        let radius = (cam.tan_x * depth / cam.width as f64).max(1e-9) / c.sqrt();
         if best.as_ref().is_none_or(|b| radius < b.radius) {
             best = Some(Silhouette {
                 depth,

@@ -163,3 +163,45 @@ fn the_covariance_pass_weights_estimate_the_radiance() {
         "weights {mean} ± {se}, closed form {exact}"
     );
 }
+
+/// A step in albedo enters the pass as an edge weighted by its contrast (the amplitude
+/// convention, docs/physics.md section 3): two quads meeting under the camera, of albedos
+/// 0.5 and `other`. The pixels beside the boundary predict more detail for a strong step
+/// (0.05 against 0.5) than for a faint one (0.45), in the ratio of their contrasts, and
+/// none where the two materials are the same; pixels far from it see no edge.
+#[test]
+fn a_material_edge_weighs_by_its_contrast() {
+    let sigma_xx = |other: f64| -> (f64, f64) {
+        let text = format!(
+            r#"Scene(
+            camera: (position: (0.0, 1.0, 0.0), look_at: (0.0, 0.0, 0.0), up: (0.0, 0.0, -1.0), fov: 10.0, width: 8, height: 8),
+            materials: {{ "a": Diffuse(albedo: (0.5, 0.5, 0.5)), "b": Diffuse(albedo: ({other:?}, {other:?}, {other:?})) }},
+            lights: [Sphere(center: (0.0, 2.0, 0.0), radius: 0.5, radiance: (1.0, 1.0, 1.0))],
+            shapes: [
+                Quad(corner: (-5.0, 0.0, -5.0), edge_u: (5.0, 0.0, 0.0), edge_v: (0.0, 0.0, 10.0), material: "a"),
+                Quad(corner: (0.0, 0.0, -5.0), edge_u: (5.0, 0.0, 0.0), edge_v: (0.0, 0.0, 10.0), material: "b"),
+            ],
+        )"#
+        );
+        let world = World::from_text(&text, "<test>", std::path::Path::new(".")).unwrap();
+        let maps = covariance_maps(&world, 4, 1, 1, None).unwrap();
+        // Less the pixel filter's own window, which every pixel has.
+        let f = cov_sensor::SensorParams::default().filter;
+        let own = 1.0 / (4.0 * std::f64::consts::PI.powi(2) * f * f);
+        let at = |x: usize| maps.pixels[4 * 8 + x].sigma[0] - own;
+        (at(3).max(at(4)), at(0))
+    };
+    let (strong, far_strong) = sigma_xx(0.05);
+    let (faint, far_faint) = sigma_xx(0.45);
+    let (same, _) = sigma_xx(0.5);
+    // The window of the edge scales with the contrast, |0.5 − b| / 0.5: 0.9 against 0.1.
+    assert!(
+        (strong / faint / 9.0 - 1.0).abs() < 1e-3,
+        "strong {strong}, faint {faint}"
+    );
+    assert!(same.abs() < 1e-9 * strong, "faint {faint}, none {same}");
+    assert!(
+        far_strong.abs().max(far_faint.abs()) < 1e-9 * strong,
+        "{far_strong} {far_faint}"
+    );
+}
