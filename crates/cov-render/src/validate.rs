@@ -148,18 +148,17 @@ fn spectrum(tile: &[f64]) -> Vec<Complex<f64>> {
     buf
 }
 
-/// The normalised second moment `tr Σ` of a spectrum (amplitude or power; DC excluded).
-fn second_moment(amp: &[f64]) -> Option<f64> {
+/// The normalised second moment `tr Σ` of the spectrum `value(k)` over the bins `(kx,
+/// ky)` that `counted` keeps (`k = ky·T + kx`); `None` when their total is not positive.
+fn moment(counted: impl Fn(usize, usize) -> bool, value: impl Fn(usize) -> f64) -> Option<f64> {
     let (mut s, mut m) = (0.0, 0.0);
     for ky in 0..T {
         for kx in 0..T {
-            if kx == 0 && ky == 0 {
-                continue;
+            if counted(kx, ky) {
+                let a = value(ky * T + kx);
+                s += a;
+                m += a * (freq(kx).powi(2) + freq(ky).powi(2));
             }
-            let a = amp[ky * T + kx];
-            let (fx, fy) = (freq(kx), freq(ky));
-            s += a;
-            m += a * (fx * fx + fy * fy);
         }
     }
     (s > 0.0).then(|| m / s)
@@ -233,21 +232,13 @@ fn band(fa: &[Complex<f64>], fb: &[Complex<f64>]) -> Option<(usize, usize)> {
 }
 
 /// The second moment of the cross power of the variation spectra `fa`, `fb` over their
-/// [`band`] (DC excluded): what the variation alone shows, whatever its contrast.
-fn ring_moment(fa: &[Complex<f64>], fb: &[Complex<f64>]) -> Option<f64> {
-    let (lo, hi) = band(fa, fb)?;
-    let (mut s, mut mom) = (0.0, 0.0);
-    for ky in 0..T {
-        for kx in 0..T {
-            if (kx, ky) == (0, 0) || !(lo..=hi).contains(&ring_of(kx, ky)) {
-                continue;
-            }
-            let cross = (fa[ky * T + kx] * fb[ky * T + kx].conj()).re;
-            s += cross;
-            mom += cross * (freq(kx).powi(2) + freq(ky).powi(2));
-        }
-    }
-    (s > 0.0).then(|| (mom / s).max(0.0))
+/// [`band`] `lo..=hi` (DC excluded): what the variation alone shows, whatever its contrast.
+fn power_moment(fa: &[Complex<f64>], fb: &[Complex<f64>], (lo, hi): (usize, usize)) -> Option<f64> {
+    moment(
+        |kx, ky| (kx, ky) != (0, 0) && (lo..=hi).contains(&ring_of(kx, ky)),
+        |k| (fa[k] * fb[k].conj()).re,
+    )
+    .map(|m| m.max(0.0))
 }
 
 /// Whether bin `k` holds the window's own spectrum: the Hann window of [`hann`] has its
@@ -263,20 +254,11 @@ fn in_mean(k: usize) -> bool {
 /// whose noise term vanishes in expectation before the root; restricting it to the
 /// significant band keeps the root's bias on noise-only bins out.
 fn amplitude_moment(ga: &[Complex<f64>], gb: &[Complex<f64>], (lo, hi): (usize, usize), own: f64) -> f64 {
-    let (mut s, mut mom) = (0.0, 0.0);
-    for ky in 0..T {
-        for kx in 0..T {
-            let counted = (in_mean(kx) && in_mean(ky)) || (lo..=hi).contains(&ring_of(kx, ky));
-            if !counted {
-                continue;
-            }
-            let k = ky * T + kx;
-            let a = (ga[k] * gb[k].conj()).re.max(0.0).sqrt();
-            s += a;
-            mom += a * (freq(kx).powi(2) + freq(ky).powi(2));
-        }
-    }
-    if s > 0.0 { (mom / s - own).max(0.0) } else { 0.0 }
+    moment(
+        |kx, ky| (in_mean(kx) && in_mean(ky)) || (lo..=hi).contains(&ring_of(kx, ky)),
+        |k| (ga[k] * gb[k].conj()).re.max(0.0).sqrt(),
+    )
+    .map_or(0.0, |m| (m - own).max(0.0))
 }
 
 /// Ranks (average ranks for ties) of `v`.
@@ -333,15 +315,10 @@ pub fn compare(a: &Image, b: &Image, maps: &CovMaps, pixel_filter: f64) -> Agree
         }
     }
     let wspec = spectrum(&wtile);
-    let wpow: Vec<f64> = wspec.iter().map(|c| c.norm_sqr()).collect();
-    let own = second_moment(&wpow).unwrap_or(0.0);
-    // The window's amplitude moment, its DC included as the tile's mean is.
-    let (mut wsum, mut wmom) = (0.0, 0.0);
-    for (k, c) in wspec.iter().enumerate() {
-        wsum += c.norm();
-        wmom += c.norm() * (freq(k % T).powi(2) + freq(k / T).powi(2));
-    }
-    let own_amp = wmom / wsum;
+    // The window's power moment (DC excluded, as for the variation), and its amplitude
+    // moment (DC included, as the tile's mean is).
+    let own = moment(|kx, ky| (kx, ky) != (0, 0), |k| wspec[k].norm_sqr()).unwrap_or(0.0);
+    let own_amp = moment(|_, _| true, |k| wspec[k].norm()).unwrap_or(0.0);
     let n_px = a.pixels.len().max(1) as f64;
     let mean_l = a
         .pixels
@@ -387,13 +364,13 @@ pub fn compare(a: &Image, b: &Image, maps: &CovMaps, pixel_filter: f64) -> Agree
             // Noise power from the difference of the two renders: E|F_a − F_b|² = 2 N.
             let noise: f64 = fa.iter().zip(&fb).map(|(p, q)| (p - q).norm_sqr()).sum::<f64>() / 2.0;
             let signal: f64 = cross.iter().sum::<f64>();
-            let variation = ring_moment(&fa, &fb).map_or(0.0, |m| (2.0 * (m - own)).max(0.0).sqrt());
-            let measured = match band(&fa, &fb) {
+            let (variation, measured) = match band(&fa, &fb) {
                 Some(b) => {
                     let (ga, gb) = (spectrum(&whole_a), spectrum(&whole_b));
-                    amplitude_moment(&ga, &gb, b, own_amp).sqrt()
+                    let power = power_moment(&fa, &fb, b).map_or(0.0, |m| (2.0 * (m - own)).max(0.0).sqrt());
+                    (power, amplitude_moment(&ga, &gb, b, own_amp).sqrt())
                 }
-                None => 0.0,
+                None => (0.0, 0.0),
             };
             let mut pred = 0.0;
             for y in 0..T {
@@ -546,6 +523,11 @@ mod tests {
             );
             assert!((t.contrast / (a / (m + a)) - 1.0).abs() < 0.01, "{t:?}");
         }
+    }
+
+    /// The variation's power moment over its band.
+    fn ring_moment(fa: &[Complex<f64>], fb: &[Complex<f64>]) -> Option<f64> {
+        power_moment(fa, fb, band(fa, fb)?)
     }
 
     /// Spectra of a tile: `content` (the same in both) plus, in `fa` only, `extra`.
