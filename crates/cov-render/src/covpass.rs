@@ -456,7 +456,7 @@ fn direct_proxy(world: &World, hit: Option<&Hit>, d: DVec3, footprint: f64) -> f
 /// The contrast of a step between radiances `a` and `b` (both ≥ 0), `|a − b| / max(a, b)`:
 /// the step's share of the amplitude spectrum relative to a full-contrast edge (one side
 /// dark), the model of cov-occlusion's `Texture::from_moments` applied to a step
-/// (docs/physics.md section 3, "textures"). A field `b + (a − b)·s(x)` with `s` a unit
+/// (docs/physics.md section 3, "edges of partial contrast"). A field `b + (a − b)·s(x)` with `s` a unit
 /// step has the amplitude `|a − b|` on the step's spectrum against `min(a, b)` on the
 /// Dirac at zero, so the edge's window is weighed by `|a − b| / (min + |a − b|)`. Both
 /// sides dark (light that only arrives indirectly): 1, the full-contrast edge, as before.
@@ -534,6 +534,8 @@ fn nearest_silhouette(
             ),
             None => (hit.t, hit.velocity),
         };
+        // The path's own side, once, seen along the first probe that finds an edge (half a
+        // pixel from the path's own ray).
         let l_here = *here.get_or_insert_with(|| direct_proxy(world, Some(hit), r.dir, footprint));
         let c = contrast(l_here, direct_proxy(world, h.as_ref(), r.dir, footprint));
         if c <= 0.0 {

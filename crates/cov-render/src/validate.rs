@@ -307,7 +307,6 @@ pub fn spearman(a: &[f64], b: &[f64]) -> f64 {
 pub fn compare(a: &Image, b: &Image, maps: &CovMaps, pixel_filter: f64) -> Agreement {
     let (w, h) = (a.width as usize, a.height as usize);
     let win = hann();
-    // The window's own second moment (its amplitude spectrum alone).
     let mut wtile = vec![0.0; T * T];
     for y in 0..T {
         for x in 0..T {
@@ -328,10 +327,8 @@ pub fn compare(a: &Image, b: &Image, maps: &CovMaps, pixel_filter: f64) -> Agree
         .sum::<f64>()
         / n_px;
     let px_window = 1.0 / (4.0 * PI * PI * pixel_filter * pixel_filter);
-    // The tile's luminance and its mean, the variation windowed, and the whole tile
-    // windowed.
-    type Windowed = (Vec<f64>, f64, Vec<f64>, Vec<f64>);
-    let windowed = |img: &Image, tx: usize, ty: usize| -> Windowed {
+    // The tile's luminance, its mean, and the variation windowed.
+    let windowed = |img: &Image, tx: usize, ty: usize| -> (Vec<f64>, f64, Vec<f64>) {
         let mut lum = vec![0.0; T * T];
         for y in 0..T {
             for x in 0..T {
@@ -341,14 +338,13 @@ pub fn compare(a: &Image, b: &Image, maps: &CovMaps, pixel_filter: f64) -> Agree
         let mean = lum.iter().sum::<f64>() / (T * T) as f64;
         let w = |k: usize| win[k % T] * win[k / T];
         let var = lum.iter().enumerate().map(|(k, v)| (v - mean) * w(k)).collect();
-        let whole = lum.iter().enumerate().map(|(k, v)| v * w(k)).collect();
-        (lum, mean, var, whole)
+        (lum, mean, var)
     };
     let mut tiles = Vec::new();
     for ty in 0..h / T {
         for tx in 0..w / T {
-            let (la, ma, wa, whole_a) = windowed(a, tx, ty);
-            let (lb, mb, wb, whole_b) = windowed(b, tx, ty);
+            let (la, ma, wa) = windowed(a, tx, ty);
+            let (lb, mb, wb) = windowed(b, tx, ty);
             let sd =
                 |l: &[f64], m: f64| (l.iter().map(|v| (v - m).powi(2)).sum::<f64>() / (T * T) as f64).sqrt();
             let (sa, sb) = (sd(&la, ma), sd(&lb, mb));
@@ -366,7 +362,11 @@ pub fn compare(a: &Image, b: &Image, maps: &CovMaps, pixel_filter: f64) -> Agree
             let signal: f64 = cross.iter().sum::<f64>();
             let (variation, measured) = match band(&fa, &fb) {
                 Some(b) => {
-                    let (ga, gb) = (spectrum(&whole_a), spectrum(&whole_b));
+                    // The whole tile's spectra, the mean put back by linearity: G = F + m·Ŵ.
+                    let whole = |f: &[Complex<f64>], m: f64| -> Vec<Complex<f64>> {
+                        f.iter().zip(&wspec).map(|(v, wk)| v + wk * m).collect()
+                    };
+                    let (ga, gb) = (whole(&fa, ma), whole(&fb, mb));
                     let power = power_moment(&fa, &fb, b).map_or(0.0, |m| (2.0 * (m - own)).max(0.0).sqrt());
                     (power, amplitude_moment(&ga, &gb, b, own_amp).sqrt())
                 }
