@@ -49,6 +49,12 @@
 //! `cos θ` (cov-curvature's `Curvature::apply_oblique`), which gives the tangential and
 //! sagittal focal lengths `R cos θ / 2` and `R / (2 cos θ)`.
 //!
+//! **Handedness.** The incident frame has `y = n × t` (`t` the tangent direction of its
+//! `x`, `n` the normal), which for a ray arriving at the surface is `−(d × x)`; the
+//! reflected frame has `y = d × x`. A renderer that frames every ray as `(x, d × x)`
+//! therefore flips `y` and `v` after the composite, with the turn measured in its own
+//! frames (docs/physics.md section 3): a mirror reverses handedness.
+//!
 //! ```
 //! use cov_brdf::{Lobe, Reflect};
 //! use cov_core::{Cov, Operator};

@@ -70,6 +70,10 @@ pub struct BenchArgs {
     /// `stride × stride` pixels (1, 2, 4, 8 or 16).
     #[arg(long, default_value_t = 4)]
     pub cov_stride: u32,
+    /// Surface vertices each covariance path follows: 1 (camera → hit → light) to 2
+    /// (every vertex the path tracer samples).
+    #[arg(long, default_value_t = cov_render::MAX_DEPTH)]
+    pub cov_depth: u32,
     /// Render at this size instead of the scene's (`WIDTHxHEIGHT`).
     #[arg(long, value_parser = parse_size)]
     pub size: Option<(u32, u32)>,
@@ -289,6 +293,7 @@ pub fn bench(a: &BenchArgs) -> Result<String, String> {
         denoise,
         cov_paths: a.cov_paths,
         cov_stride: a.cov_stride,
+        cov_depth: a.cov_depth,
         parts: a.parts,
         ..RenderSettings::default()
     };
@@ -323,8 +328,9 @@ pub fn bench(a: &BenchArgs) -> Result<String, String> {
         if let Some(g) = &best {
             let _ = writeln!(
                 out,
-                "covariance pass: {} path(s) per {s}×{s} block, {:.3} s (with the matched filters)",
+                "covariance pass: {} path(s) of depth {} per {s}×{s} block, {:.3} s (with the matched filters)",
                 a.cov_paths,
+                a.cov_depth,
                 g.secs,
                 s = a.cov_stride
             );

@@ -46,6 +46,10 @@ pub struct RenderArgs {
     /// Side of the covariance grid's blocks (px): 1, 2, 4, 8 or 16.
     #[arg(long, default_value_t = 4)]
     pub cov_stride: u32,
+    /// Surface vertices each covariance path follows: 1 (camera → hit → light) to 2
+    /// (every vertex the path tracer samples).
+    #[arg(long, default_value_t = cov_render::MAX_DEPTH)]
+    pub cov_depth: u32,
     /// Seed of the random numbers (the image does not depend on the thread count).
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
@@ -170,6 +174,7 @@ pub fn settings(a: &RenderArgs) -> Result<RenderSettings, String> {
         time: a.time,
         cov_paths: a.cov_paths,
         cov_stride: a.cov_stride,
+        cov_depth: a.cov_depth,
         max_luminance: f64::INFINITY,
         denoise: a.denoise,
         parts: match (a.part, a.parts) {
@@ -550,6 +555,10 @@ pub struct CheckArgs {
     /// Covariance paths per pixel.
     #[arg(long, default_value_t = 8)]
     pub cov_paths: u32,
+    /// Surface vertices each covariance path follows: 1 (camera → hit → light) to 2
+    /// (every vertex the path tracer samples).
+    #[arg(long, default_value_t = cov_render::MAX_DEPTH)]
+    pub cov_depth: u32,
     /// Render at this size instead of the scene's (`WIDTHxHEIGHT`).
     #[arg(long, value_parser = parse_size)]
     pub size: Option<(u32, u32)>,
@@ -611,6 +620,7 @@ pub fn check(a: &CheckArgs) -> Result<String, String> {
         RenderSettings {
             cov_paths: a.cov_paths,
             cov_stride: 1,
+            cov_depth: a.cov_depth,
             seed: a.seed,
             ..RenderSettings::default()
         },

@@ -1,15 +1,16 @@
 //! Renderer speed: primary rays per second (camera ray, BVH hit, shading with one light
-//! sample and one bounce) and covariance paths per second, on the bundled scenes at a
-//! small size; and the guard's stages against the path tracing they serve. Run:
+//! sample and one bounce) and covariance paths per second at each depth, on the bundled
+//! scenes at a small size; and the guard's stages against the path tracing they serve. Run:
 //! `cargo bench -p cov-render --bench render`; compare within one run.
 
 use std::hint::black_box;
 use std::path::Path;
 
 use cov_render::adaptive::Guide;
+use cov_render::covpass::covariance_rows;
 use cov_render::film::Film;
 use cov_render::guard::{candidates, chosen_filters, guarded};
-use cov_render::{World, covariance_maps, render};
+use cov_render::{MAX_DEPTH, World, covariance_maps, render};
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 
 const W: u32 = 64;
@@ -41,10 +42,19 @@ fn scenes(c: &mut Criterion) {
         g.bench_function("path tracing, 1 spp, 1 thread (elements = camera samples)", |b| {
             b.iter(|| pool.install(|| black_box(render(&world, 1, 1))))
         });
-        g.bench_function(
-            "covariance pass, 1 path per pixel, 1 thread (elements = paths)",
-            |b| b.iter(|| pool.install(|| black_box(covariance_maps(&world, 1, 1, 1, None).expect("maps")))),
-        );
+        // The pass's cost per depth (surface vertices per path).
+        for depth in 1..=MAX_DEPTH {
+            g.bench_function(
+                format!("covariance pass, 1 path per pixel, depth {depth}, 1 thread (elements = paths)"),
+                |b| {
+                    b.iter(|| {
+                        pool.install(|| {
+                            black_box(covariance_rows(&world, 1, 1, depth, 1, 0..H, None).expect("maps"))
+                        })
+                    })
+                },
+            );
+        }
         g.finish();
     }
 }

@@ -1,28 +1,33 @@
-//! The covariance pass: for each pixel, a few covariance paths (camera → first hit → a
-//! light), each turned into an operator chain of the library (light source, travel,
-//! blocker edge, reflection at the hit, motion, lens, shutter), evaluated, and reduced to
-//! the sensor's per-pixel decisions (cov-sensor). Paths are weighted by the radiance they
-//! carry, ignoring visibility, so a shadowed region keeps the frequency content of the
-//! light, blockers and surface around it.
+//! The covariance pass: for each pixel, a few covariance paths that follow the path
+//! tracer's paths (camera → x₁ → light, camera → x₁ → x₂ → light; up to [`MAX_DEPTH`]
+//! surface vertices), each vertex's direct light turned into an operator chain of the
+//! library (light source, travel, blocker edge, reflection at each vertex back to the
+//! camera, motion, lens, shutter), evaluated, and reduced to the sensor's per-pixel
+//! decisions (cov-sensor). Every vertex's chain is weighted by the radiance it carries to
+//! the camera, ignoring visibility, so a shadowed region keeps the frequency content of
+//! the light, blockers and surface around it.
 //!
-//! What a path sees, in light order:
+//! What a vertex's chain sees, in light order:
 //!
 //! 1. the emitter as a Gaussian window of the light's size ([`crate::world::Light::window_std`]),
-//!    constant in angle and time, seen from the hit through `Unproject(cos_l)`;
-//! 2. travel to the hit, with a `BlockerEdge` where auxiliary shadow rays to other points
-//!    of the light are blocked (the distance from the path to the nearest blocker hit, at
-//!    the blocker's depth);
-//! 3. the reflection at the hit (cov-brdf's `Reflect::with_turn`: the shape's curvature,
+//!    constant in angle and time, seen from the vertex through `Unproject(cos_l)`;
+//! 2. travel to the vertex, with a `BlockerEdge` where auxiliary shadow rays to other
+//!    points of the light are blocked (the distance from the path to the nearest blocker
+//!    hit, at the blocker's depth);
+//! 3. the reflection at the vertex (cov-brdf's `Reflect::with_turn`: the shape's curvature,
 //!    the material's lobe, and the turn from the plane of incidence to the plane of the
-//!    outgoing ray), inside `Moving` when the shape moves;
-//! 4. travel to the camera, with a `Moving` `BlockerEdge` where auxiliary camera rays
+//!    outgoing ray; then the change of handedness and the texture), inside `Moving` when
+//!    the shape moves;
+//! 4. for a second vertex, travel back along the path to the first and the reflection
+//!    there, as in 3 (glossy inter-reflection: a glossy floor mirroring what stands on it);
+//! 5. travel to the camera, with a `Moving` `BlockerEdge` where auxiliary camera rays
 //!    around the pixel see a silhouette (a nearer surface or the background) in front of
 //!    or behind the hit, a crease or another material, its window weighed by the step's
 //!    contrast (docs/physics.md section 3): defocus and motion blur of edges;
-//! 5. the camera: its motion, the shutter window, the thin lens (or pinhole), and the
+//! 6. the camera: its motion, the shutter window, the thin lens (or pinhole), and the
 //!    sensor's sampling rates (`Sensor::rates`).
 //!
-//! The pass holds Σ in covariance form: chains are short (at most about 15 operators), where
+//! The pass holds Σ in covariance form: chains are short (at most about 20 operators), where
 //! both forms agree to rounding.
 
 use cov_brdf::Reflect;
@@ -226,114 +231,271 @@ fn texture_window(
     Ok(best)
 }
 
+/// Surface vertices a covariance path follows at most: those of the path tracer's paths
+/// (camera → x₁ → light and camera → x₁ → x₂ → light, crate::trace). A deeper vertex
+/// would predict light the image does not have.
+pub const MAX_DEPTH: u32 = 2;
+
+/// The footprints on a surface seen at distance `dist` along the path from the camera, at
+/// the cosine `cos_o` to the ray that leaves it, for a block of side `side` (px): half a
+/// pixel, the finest detail the pixel grid can show (its Nyquist rate), where textures
+/// are band-limited (stretched by the inverse projection's geometric mean over the two
+/// axes); and twice the block's side along the stretched axis, a square that holds the
+/// whole block wherever in it the path lands, over which the prediction is used and the
+/// texture's statistics are averaged.
+fn footprints(world: &World, dist: f64, cos_o: f64, side: f64) -> (f64, f64) {
+    let cam = &world.camera;
+    let cos_o = cos_o.abs().clamp(1e-6, 1.0);
+    let pitch = 2.0 * cam.tan_x * dist / cam.width as f64;
+    (0.5 * pitch / cos_o.sqrt(), 2.0 * side * pitch / cos_o)
+}
+
 /// Traces one covariance path through the pixel point `(px, py)` of `block` at time
-/// uniform `ut`; returns the sensor's rates and the path's weight, or `None` when the path
-/// sees nothing. Textures are read over the block's footprint, and edges are looked for
-/// around the path and at the block's corners.
+/// uniform `ut`, through at most `depth` surface vertices (1 to [`MAX_DEPTH`]); returns,
+/// for every vertex, the sensor's rates of the direct light it reflects along the path,
+/// with that light's weight (its luminance times the path's throughput to the camera).
+/// Empty when the path sees nothing. Textures are read over the block's footprint, and
+/// edges are looked for around the path and at the block's corners.
+///
+/// Each vertex's chain runs in light order: the emitter, travel past the nearest blocker,
+/// the reflection there; then, back along the path, travel to the vertex before, its
+/// reflection towards the vertex before it, and so on to the first hit; then the camera
+/// side (silhouettes, the camera), shared by every vertex. The next vertex is drawn from
+/// the material's lobe as the path tracer draws it. A light found that way ends the path:
+/// its reflection is the direct light of the vertex before, already counted.
 pub fn trace_path<R: Rng>(
     world: &World,
     cc: &CovCamera,
     (px, py): (f64, f64),
     block: Block,
     ut: f64,
+    depth: u32,
     rng: &mut R,
-) -> Result<Option<(PixelRates, f64)>, CovError> {
+) -> Result<Vec<(PixelRates, f64)>, CovError> {
     let cam = &world.camera;
     let ray = cam.ray(px, py, (0.5, 0.5), ut);
     let time = ray.time;
+    let mut out = Vec::new();
     let Some(hit) = world
         .geometry
         .intersect(ray.origin, ray.dir, time, 0.0, f64::INFINITY)
     else {
-        return Ok(None);
+        return Ok(out);
     };
     let motion = cc.layout == 5;
     let d_out = -ray.dir; // from the hit towards the camera
-    let mut chain = Chain::new();
-    let weight;
-    let start;
     let x_out = frame_x(d_out, hit.n);
-    // Footprints on the surface (m): half a pixel, the finest detail the pixel grid can
-    // show (its Nyquist rate), where textures are band-limited (stretched by the inverse
-    // projection's geometric mean over the two axes); and twice the block's side along
-    // the stretched axis, a square that holds the whole block wherever in it the path
-    // lands, over which the prediction is used and the texture's statistics are averaged.
-    let cos_o = hit.n.dot(d_out).abs().clamp(1e-6, 1.0);
-    let pitch = 2.0 * cam.tan_x * hit.t / cam.width as f64;
     let side = (block[2] - block[0]).max(block[3] - block[1]).max(1.0);
-    let footprint = (0.5 * pitch / cos_o.sqrt(), 2.0 * side * pitch / cos_o);
+    let footprint = footprints(world, hit.t, hit.n.dot(d_out), side);
+    // 5–6. The camera side, the end of every vertex's chain.
+    let tail = camera_side(
+        world,
+        cc,
+        (&hit, d_out),
+        ((px, py), block),
+        (time, ut),
+        footprint.0,
+    )?;
+    let mut emit = |start: &AnyCov, chain: &Chain, weight: f64| -> Result<(), CovError> {
+        let rates = cc.sensor.rates(&chain.eval_any(Form::Covariance, start)?)?;
+        if weight.is_finite() && weight >= 0.0 {
+            out.push((rates, weight));
+        }
+        Ok(())
+    };
     if let Some(li) = hit.light {
         // A light seen directly: its window, seen at the angle of the camera ray.
         let light = &world.lights[li as usize];
-        weight = luminance(light.radiance()).max(0.0) * if hit.front { 1.0 } else { 0.0 };
-        start = source(cc.layout, light.window_std())?;
-        chain.push(Unproject::new(hit.ng.dot(d_out).abs().clamp(1e-6, 1.0))?);
-    } else {
-        let n_l = world.lights.len();
-        let pick = ((rng.random::<f64>() * n_l as f64) as usize).min(n_l - 1);
-        let light = &world.lights[pick];
-        let ls = light.sample(hit.p, rng.random(), rng.random());
-        let mat = &world.material_at(&hit, footprint.0);
-        let (cos_i, f) = ls.map_or((0.0, DVec3::ZERO), |ls| {
-            (hit.n.dot(ls.wi), mat.eval(hit.n, d_out, ls.wi))
-        });
-        if let (Some(ls), true) = (ls, cos_i > 0.0 && f != DVec3::ZERO) {
-            weight = luminance(f * ls.radiance) * cos_i * n_l as f64 / ls.pdf;
-            let d_in = -ls.wi; // from the light towards the hit
-            // 1. The emitter window, foreshortened towards the hit.
-            start = source(cc.layout, light.window_std())?;
-            let cos_l = ls.n.dot(ls.wi).abs().clamp(1e-6, 1.0);
-            let x_l = frame_x(d_in, ls.n);
-            let x_in = frame_x(d_in, hit.n);
-            chain.push(Unproject::new(cos_l)?);
-            chain.push(RotateFrame::new(turn(d_in, x_l, x_in))?);
-            // 2. Travel, with the nearest blocker near the path.
-            match nearest_blocker(world, &hit, light, ls.y, time, rng) {
-                Some((s_b, r_b)) => {
-                    chain.push(Travel::new(s_b)?);
-                    chain.push(BlockerEdge::new(r_b)?);
-                    chain.push(Travel::new((ls.dist - s_b).max(0.0))?);
-                }
-                None => chain.push(Travel::new(ls.dist)?),
-            }
-            // 3. The reflection, in the shape's frame when it moves.
-            let t_in = (x_in - hit.n * x_in.dot(hit.n)).normalize_or_zero();
-            let t_out = (x_out - hit.n * x_out.dot(hit.n)).normalize_or_zero();
-            let y_in = d_in.cross(x_in);
-            let bounce = Reflect::with_turn(
-                cos_i.clamp(1e-6, 1.0),
-                hit.n.dot(d_out).clamp(1e-6, 1.0),
-                Curvature::isotropic(hit.curvature)?,
-                mat.lobe(),
-                t_out.dot(y_in).atan2(t_out.dot(t_in)),
-            )?;
-            // The texture multiplies the reflected light where it leaves the surface (it
-            // commutes with the lobe: a window in position, a convolution in angle).
-            let mut at_surface = Chain::new().with(bounce);
-            if let Some(t) = texture_window(world, &hit, d_out, x_out, footprint)? {
-                at_surface.push(t);
-            }
-            push_on(&mut chain, motion, hit.velocity, (d_out, x_out), at_surface)?;
-        } else {
-            // The light sample does not reach this side: what the camera sees here is
-            // indirect light, taken as constant (Σ = 0) where it leaves the surface. The
-            // camera side (silhouettes, defocus, motion) still counts, with weight 0.
-            weight = 0.0;
-            start = AnyCov::zeros(cc.layout)?;
-            if let Some(t) = texture_window(world, &hit, d_out, x_out, footprint)? {
-                push_on(
-                    &mut chain,
-                    motion,
-                    hit.velocity,
-                    (d_out, x_out),
-                    Chain::new().with(t),
-                )?;
-            }
-        }
+        let weight = luminance(light.radiance()).max(0.0) * if hit.front { 1.0 } else { 0.0 };
+        let chain = Chain::new()
+            .with(Unproject::new(hit.ng.dot(d_out).abs().clamp(1e-6, 1.0))?)
+            .with(tail);
+        emit(&source(cc.layout, light.window_std())?, &chain, weight)?;
+        return Ok(out);
     }
-    // 4. Travel to the camera, past the nearest silhouette.
+    let (mut v, mut d_o, mut x_o, mut fp, mut dist) = (hit, d_out, x_out, footprint, hit.t);
+    let mut tail = tail;
+    let mut throughput = DVec3::ONE;
+    for k in 0..depth.clamp(1, MAX_DEPTH) {
+        let mat = world.material_at(&v, fp.0);
+        match lit(world, cc, (&v, &mat), (d_o, x_o), (fp, time), rng)? {
+            Some((start, mut chain, w)) => {
+                chain.push(tail.clone());
+                emit(&start, &chain, luminance(throughput * w.0) * w.1)?;
+            }
+            None if k == 0 => {
+                // The light sample does not reach this side: what the camera sees here is
+                // indirect light, taken as constant (Σ = 0) where it leaves the surface.
+                // The camera side (silhouettes, defocus, motion) still counts, with weight 0.
+                let mut chain = Chain::new();
+                if let Some(t) = texture_window(world, &v, d_o, x_o, fp)? {
+                    push_on(&mut chain, motion, v.velocity, (d_o, x_o), Chain::new().with(t))?;
+                }
+                chain.push(tail.clone());
+                emit(&AnyCov::zeros(cc.layout)?, &chain, 0.0)?;
+            }
+            None => {}
+        }
+        if k + 1 >= depth {
+            break;
+        }
+        // The next vertex, drawn from the lobe as the path tracer draws it.
+        let Some(wi) = mat.sample(v.n, d_o, rng.random(), rng.random()) else {
+            break;
+        };
+        let (pdf, cos_i) = (mat.pdf(v.n, d_o, wi), v.n.dot(wi));
+        if !(pdf > 0.0 && cos_i > 0.0 && wi.dot(v.ng) > 0.0) {
+            break;
+        }
+        let Some(next) = world
+            .geometry
+            .intersect(spawn(&v, wi), wi, time, 0.0, f64::INFINITY)
+        else {
+            break;
+        };
+        if next.light.is_some() {
+            break;
+        }
+        throughput *= mat.eval(v.n, d_o, wi) * (cos_i / pdf);
+        // The light that leaves `next` towards `v`: travel, into the plane of incidence at
+        // `v`, reflected there towards the vertex before, then what followed `v`.
+        let d_in = -wi;
+        let (x_in, x_next) = (frame_x(d_in, v.n), frame_x(d_in, next.n));
+        let mut t = Chain::new()
+            .with(Travel::new(next.t)?)
+            .with(RotateFrame::new(turn(d_in, x_next, x_in))?);
+        let here = at_surface(world, &v, &mat, (d_in, x_in, cos_i), (d_o, x_o), fp)?;
+        push_on(&mut t, motion, v.velocity, (d_o, x_o), here)?;
+        t.push(tail);
+        tail = t;
+        dist += next.t;
+        fp = footprints(world, dist, next.n.dot(d_in), side);
+        (v, d_o, x_o) = (next, d_in, x_next);
+    }
+    Ok(out)
+}
+
+/// The change of handedness at a reflection, `l'(x, y, u, v) = l(x, −y, u, −v)`. The pass
+/// frames every ray right-handed, `(x, d × x)` with `x` in the plane of incidence.
+/// cov-brdf's `Reflect` takes the incident frame with `y = n × t` (`t` the tangent of `x`),
+/// which is `−(d × x)` for light arriving at the surface, and gives the reflected ray's
+/// frame right-handed. Flipping `y` before it, with the turn's sign reversed (its `y` is
+/// reversed), is the same as flipping `y` after it with the turn measured in the pass's own
+/// frame: the flip commutes with the projections, the isotropic curvature, the mirror
+/// symmetry and the pass's isotropic lobes, and reverses a rotation. A mirror shows the
+/// image of what it reflects, not a rotated copy (test `a_mirror_shows_what_it_reflects`).
+#[derive(Debug)]
+struct Handedness;
+
+impl cov_core::Operator for Handedness {
+    fn apply(&self, cov: &mut dyn cov_core::Spectrum) -> Result<(), CovError> {
+        cov.scale(cov_core::Axis::Y, -1.0)?;
+        cov.scale(cov_core::Axis::V, -1.0)
+    }
+
+    fn requires(&self) -> cov_core::AxisSet {
+        cov_core::AxisSet::SPACE
+    }
+}
+
+/// The reflection at the vertex `v` of light arriving along `d_in` (frame `x_in`, cosine
+/// `cos_i` to the normal) towards `d_out` (frame `x_out`), in the frame of `d_out`:
+/// cov-brdf's `Reflect::with_turn` (the shape's curvature, the material's lobe, the turn
+/// from the plane of incidence to the plane of the outgoing ray) and the change of
+/// [`Handedness`], then the texture, which
+/// multiplies the reflected light where it leaves the surface (it commutes with the lobe:
+/// a window in position, a convolution in angle).
+fn at_surface(
+    world: &World,
+    v: &Hit,
+    mat: &crate::material::Material,
+    (d_in, x_in, cos_i): (DVec3, DVec3, f64),
+    (d_out, x_out): (DVec3, DVec3),
+    footprint: (f64, f64),
+) -> Result<Chain, CovError> {
+    let t_in = (x_in - v.n * x_in.dot(v.n)).normalize_or_zero();
+    let t_out = (x_out - v.n * x_out.dot(v.n)).normalize_or_zero();
+    let y_in = d_in.cross(x_in);
+    let bounce = Reflect::with_turn(
+        cos_i.clamp(1e-6, 1.0),
+        v.n.dot(d_out).clamp(1e-6, 1.0),
+        Curvature::isotropic(v.curvature)?,
+        mat.lobe(),
+        t_out.dot(y_in).atan2(t_out.dot(t_in)),
+    )?;
+    let mut ops = Chain::new().with(bounce).with(Handedness);
+    if let Some(t) = texture_window(world, v, d_out, x_out, footprint)? {
+        ops.push(t);
+    }
+    Ok(ops)
+}
+
+/// The direct light that the vertex `v` of material `mat` reflects along `d_out` (frame
+/// `x_out`), for one light sample: the source Σ, the chain from the emitter to the light
+/// leaving `v` (1. the emitter window, foreshortened towards `v`; 2. travel, with the
+/// nearest blocker near the path; 3. the reflection, in the shape's frame when it moves),
+/// and the weight `(f·L, cos·n_lights/pdf)`, ignoring visibility. `None` when the sample
+/// does not reach this side.
+#[allow(clippy::type_complexity)]
+fn lit<R: Rng>(
+    world: &World,
+    cc: &CovCamera,
+    (v, mat): (&Hit, &crate::material::Material),
+    (d_out, x_out): (DVec3, DVec3),
+    (footprint, time): ((f64, f64), f64),
+    rng: &mut R,
+) -> Result<Option<(AnyCov, Chain, (DVec3, f64))>, CovError> {
+    let n_l = world.lights.len();
+    let pick = ((rng.random::<f64>() * n_l as f64) as usize).min(n_l - 1);
+    let light = &world.lights[pick];
+    let Some(ls) = light.sample(v.p, rng.random(), rng.random()) else {
+        return Ok(None);
+    };
+    let (cos_i, f) = (v.n.dot(ls.wi), mat.eval(v.n, d_out, ls.wi));
+    if !(cos_i > 0.0 && f != DVec3::ZERO) {
+        return Ok(None);
+    }
+    let d_in = -ls.wi; // from the light towards the vertex
+    let start = source(cc.layout, light.window_std())?;
+    let cos_l = ls.n.dot(ls.wi).abs().clamp(1e-6, 1.0);
+    let (x_l, x_in) = (frame_x(d_in, ls.n), frame_x(d_in, v.n));
+    let mut chain = Chain::new()
+        .with(Unproject::new(cos_l)?)
+        .with(RotateFrame::new(turn(d_in, x_l, x_in))?);
+    match nearest_blocker(world, v, light, ls.y, time, rng) {
+        Some((s_b, r_b)) => {
+            chain.push(Travel::new(s_b)?);
+            chain.push(BlockerEdge::new(r_b)?);
+            chain.push(Travel::new((ls.dist - s_b).max(0.0))?);
+        }
+        None => chain.push(Travel::new(ls.dist)?),
+    }
+    let here = at_surface(world, v, mat, (d_in, x_in, cos_i), (d_out, x_out), footprint)?;
+    push_on(&mut chain, cc.layout == 5, v.velocity, (d_out, x_out), here)?;
+    Ok(Some((
+        start,
+        chain,
+        (f * ls.radiance, cos_i * n_l as f64 / ls.pdf),
+    )))
+}
+
+/// The camera side of a path whose first hit is `hit`, in the frame of the hit's outgoing
+/// ray `d_out` (towards the camera): 5. travel to the camera, past the nearest silhouette; 6. the camera (its motion,
+/// the shutter, the lens, the sensor's end of the chain).
+fn camera_side(
+    world: &World,
+    cc: &CovCamera,
+    (hit, d_out): (&Hit, DVec3),
+    ((px, py), block): ((f64, f64), Block),
+    (time, ut): (f64, f64),
+    footprint: f64,
+) -> Result<Chain, CovError> {
+    let cam = &world.camera;
+    let motion = cc.layout == 5;
+    let x_out = frame_x(d_out, hit.n);
     let x_cam = frame_x(d_out, cam.right);
-    match nearest_silhouette(world, &hit, (px, py), block, (time, ut), footprint.0) {
+    let mut chain = Chain::new();
+    match nearest_silhouette(world, hit, (px, py), block, (time, ut), footprint) {
         Some(e) => {
             chain.push(Travel::new((hit.t - e.depth).max(0.0))?);
             let edge = Chain::new().with(BlockerEdge::new(e.radius)?);
@@ -343,7 +505,6 @@ pub fn trace_path<R: Rng>(
         None => chain.push(Travel::new(hit.t)?),
     }
     chain.push(RotateFrame::new(turn(d_out, x_out, x_cam))?);
-    // 5. The camera.
     if motion && cam.velocity != DVec3::ZERO {
         chain.push(CameraMotion::new(
             in_frame(cam.velocity, d_out, x_cam),
@@ -351,12 +512,7 @@ pub fn trace_path<R: Rng>(
         )?);
     }
     chain.push(cc.end.clone());
-    let at_sensor = chain.eval_any(Form::Covariance, &start)?;
-    let d = cc.sensor.rates(&at_sensor)?;
-    if !(weight.is_finite() && weight >= 0.0) {
-        return Ok(None);
-    }
-    Ok(Some((d, weight)))
+    Ok(chain)
 }
 
 /// The nearest blocker near the path from the light point `y` to the hit: auxiliary
@@ -606,8 +762,9 @@ fn tile_rng(seed: u64, index: usize) -> rand_chacha::ChaCha8Rng {
 }
 
 /// Traces `paths` covariance paths (1 to [`MAX_COV_PATHS`]) per block of `stride × stride`
-/// pixels, jittered over the block and the shutter; every pixel of a block gets the
-/// block's radiance-weighted prediction. A coarser grid costs `stride²` times less; a block
+/// pixels, jittered over the block and the shutter, each through up to [`MAX_DEPTH`]
+/// surface vertices ([`trace_path`]); every pixel of a block gets the block's
+/// radiance-weighted prediction over its paths' vertices. A coarser grid costs `stride²` times less; a block
 /// that holds an edge predicts for all its pixels the detail that its paths saw, so edges
 /// widen to the block, which narrows filters and raises densities near them
 /// (conservative).
@@ -622,20 +779,23 @@ pub fn covariance_maps(
     seed: u64,
     progress: crate::film::Progress<'_>,
 ) -> Result<CovMaps, crate::RenderError> {
-    covariance_rows(world, paths, stride, seed, 0..world.camera.height, progress)
+    let rows = 0..world.camera.height;
+    covariance_rows(world, paths, stride, MAX_DEPTH, seed, rows, progress)
 }
 
 /// [`covariance_maps`] of the tiles whose first row lies in `rows` (a part of a render,
 /// the `parts` module); the other pixels keep [`PixelCov::default`]. Each tile draws from
 /// its own generator, seeded by its index in the whole image, so a tile's values are the
-/// same whichever rows are traced.
+/// same whichever rows are traced. Paths follow at most `depth` surface vertices (1 to
+/// [`MAX_DEPTH`]; 1 traces camera → hit → light only).
 ///
 /// # Errors
-/// As [`covariance_maps`].
+/// As [`covariance_maps`], and `depth` out of range.
 pub fn covariance_rows(
     world: &World,
     paths: u32,
     stride: u32,
+    depth: u32,
     seed: u64,
     rows: std::ops::Range<u32>,
     progress: crate::film::Progress<'_>,
@@ -655,6 +815,13 @@ pub fn covariance_rows(
             paths,
         ));
     }
+    if !(1..=MAX_DEPTH).contains(&depth) {
+        return Err(crate::RenderError::setting(
+            "the covariance paths' depth",
+            format!("1 to {MAX_DEPTH}"),
+            depth,
+        ));
+    }
     let cc = CovCamera::new(world).map_err(|e| crate::RenderError::Camera(e.to_string()))?;
     let (w, h) = (world.camera.width, world.camera.height);
     let tl: Vec<(usize, (u32, u32, u32, u32))> = crate::film::tiles(w, h)
@@ -670,7 +837,7 @@ pub fn covariance_rows(
             for by in (y0..y1).step_by(stride as usize) {
                 for bx in (x0..x1).step_by(stride as usize) {
                     let (sx, sy) = ((x1 - bx).min(stride), (y1 - by).min(stride));
-                    let acc = block_cov(world, &cc, (bx, by), (sx, sy), paths, &mut rng)?;
+                    let acc = block_cov(world, &cc, (bx, by), (sx, sy), (paths, depth), &mut rng)?;
                     for y in by..by + sy {
                         for x in bx..bx + sx {
                             out[((y - y0) * (x1 - x0) + (x - x0)) as usize] = acc;
@@ -707,7 +874,7 @@ fn block_cov<R: Rng>(
     cc: &CovCamera,
     (x, y): (u32, u32),
     (sx, sy): (u32, u32),
-    paths: u32,
+    (paths, depth): (u32, u32),
     rng: &mut R,
 ) -> Result<PixelCov, crate::RenderError> {
     let mut acc = PixelCov::default();
@@ -720,25 +887,27 @@ fn block_cov<R: Rng>(
         );
         let (px, py) = (f64::from(x) + jx, f64::from(y) + jy);
         let block = [f64::from(x), f64::from(y), f64::from(x + sx), f64::from(y + sy)];
-        let r =
-            trace_path(world, cc, (px, py), block, ut, rng).map_err(|e| crate::RenderError::Covariance {
+        let r = trace_path(world, cc, (px, py), block, ut, depth, rng).map_err(|e| {
+            crate::RenderError::Covariance {
                 x: px.floor() as u32,
                 y: py.floor() as u32,
                 message: e.to_string(),
-            })?;
-        let Some((d, wgt)) = r else { continue };
-        let s = [d.image_cov_px[0][0], d.image_cov_px[0][1], d.image_cov_px[1][1]];
-        if !(s.iter().all(|v| v.is_finite()) && d.samples_per_pixel.is_finite()) {
-            continue;
+            }
+        })?;
+        for (d, wgt) in r {
+            let s = [d.image_cov_px[0][0], d.image_cov_px[0][1], d.image_cov_px[1][1]];
+            if !(s.iter().all(|v| v.is_finite()) && d.samples_per_pixel.is_finite()) {
+                continue;
+            }
+            for k in 0..3 {
+                acc.sigma[k] += wgt * s[k];
+                plain[k] += s[k];
+            }
+            acc.spp += wgt * d.samples_per_pixel;
+            acc.weight += wgt;
+            plain_spp += d.samples_per_pixel;
+            n_plain += 1.0;
         }
-        for k in 0..3 {
-            acc.sigma[k] += wgt * s[k];
-            plain[k] += s[k];
-        }
-        acc.spp += wgt * d.samples_per_pixel;
-        acc.weight += wgt;
-        plain_spp += d.samples_per_pixel;
-        n_plain += 1.0;
     }
     if acc.weight > 0.0 {
         for k in 0..3 {

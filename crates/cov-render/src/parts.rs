@@ -61,7 +61,7 @@ use crate::{RenderError, World};
 
 pub use crate::renderer::MAX_PARTS;
 /// Version of the part file's layout and key.
-pub const FORMAT: u32 = 1;
+pub const FORMAT: u32 = 2;
 /// Most channels a part file may hold (the film's 32 and the maps' 10 fit).
 const MAX_CHANNELS: usize = 64;
 
@@ -191,6 +191,8 @@ pub struct PartKey {
     pub cov_paths: u32,
     /// Side of the covariance grid's blocks (px).
     pub cov_stride: u32,
+    /// Surface vertices per covariance path.
+    pub cov_depth: u32,
     /// The luminance clamp, as text (`inf` for none).
     pub max_luminance: String,
     /// The denoiser's name.
@@ -213,6 +215,7 @@ impl PartKey {
             seed: settings.seed,
             cov_paths: settings.cov_paths,
             cov_stride: settings.cov_stride,
+            cov_depth: settings.cov_depth,
             max_luminance: settings.max_luminance.to_string(),
             denoise: settings.denoise.name().into(),
             parts: settings.parts,

@@ -41,7 +41,7 @@ use glam::DVec3;
 
 use crate::RenderError;
 use crate::adaptive::{Guide, MAX_RATIO, allocate_floors, filter_area, relative_variance};
-use crate::covpass::{CovMaps, MAX_COV_PATHS, STRIDES, covariance_rows};
+use crate::covpass::{CovMaps, MAX_COV_PATHS, MAX_DEPTH, STRIDES, covariance_rows};
 use crate::denoise::Denoise;
 use crate::film::{Film, Filter, Gaussian, Image, MAX_SPP, Progress};
 use crate::guard::{candidate, candidates, chosen_filters, guarded};
@@ -158,6 +158,9 @@ pub struct RenderSettings {
     pub cov_paths: u32,
     /// Side of the covariance grid's blocks (px, one of [`STRIDES`]).
     pub cov_stride: u32,
+    /// Surface vertices a covariance path follows (1 to [`MAX_DEPTH`], the path
+    /// tracer's; 1: camera → hit → light only).
+    pub cov_depth: u32,
     /// Every sample's luminance is clamped to this (colour scaled down); `∞` for an
     /// unbiased image. A finite clamp is biased: for measuring the spectrum of a reference
     /// without its rare caustic fireflies (`render-check`), never for an image.
@@ -173,7 +176,7 @@ pub struct RenderSettings {
 
 impl Default for RenderSettings {
     /// Covariance tracing (`cov`) at 16 samples per pixel, seed 1, one pass, one
-    /// covariance path per 4×4 block.
+    /// covariance path per 4×4 block, through every vertex the path tracer samples.
     fn default() -> RenderSettings {
         RenderSettings {
             method: Method::Cov,
@@ -182,6 +185,7 @@ impl Default for RenderSettings {
             time: None,
             cov_paths: 1,
             cov_stride: 4,
+            cov_depth: MAX_DEPTH,
             max_luminance: f64::INFINITY,
             denoise: Denoise::None,
             parts: 1,
@@ -224,6 +228,13 @@ impl RenderSettings {
                 "cov_stride",
                 format!("one of {STRIDES:?}"),
                 self.cov_stride,
+            ));
+        }
+        if !(1..=MAX_DEPTH).contains(&self.cov_depth) {
+            return Err(RenderError::setting(
+                "cov_depth",
+                format!("1 to {MAX_DEPTH}"),
+                self.cov_depth,
             ));
         }
         if !(1..=MAX_PARTS).contains(&self.parts) {
@@ -418,6 +429,7 @@ impl<'w> Renderer<'w> {
                 self.world,
                 s.cov_paths,
                 s.cov_stride,
+                s.cov_depth,
                 s.seed,
                 rows.clone(),
                 progress,
