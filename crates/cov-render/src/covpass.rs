@@ -565,7 +565,8 @@ fn nearest_blocker<R: Rng>(
     best
 }
 
-/// Relative depth difference that makes a silhouette.
+/// Depth difference that makes a silhouette, relative to the hit's depth: between what a
+/// probe ray hits and where it meets the hit's tangent plane.
 pub const DEPTH_JUMP: f64 = 0.05;
 /// Cosine of the normal turn that makes a crease (25°).
 pub const CREASE_COS: f64 = 0.906;
@@ -639,7 +640,8 @@ fn same_surface(world: &World, a: &Hit, b: &Hit) -> bool {
 
 /// An edge around the pixel: auxiliary pinhole rays half a pixel away from the path, and
 /// at the centres of the block's corner pixels, that see something else: a surface at a
-/// clearly different depth (more than [`DEPTH_JUMP`] relative) or nothing (a
+/// clearly different depth (more than [`DEPTH_JUMP`] of the hit's depth away from where
+/// the probe meets the hit's tangent plane) or nothing (a
 /// silhouette), a surface turned by more than `acos(`[`CREASE_COS`]`)` (a crease, where
 /// shading changes abruptly), another material (a step in reflectance), or an emitter
 /// where the path sees none (the edge of a light) or the reverse. The edge lies at the
@@ -676,9 +678,18 @@ fn nearest_silhouette(
         let h = world
             .geometry
             .intersect(r.origin, r.dir, time, 0.0, f64::INFINITY);
+        // Where the probe would meet the hit's tangent plane: a surface that continues
+        // smoothly is no silhouette, however oblique (at grazing angles its depth changes
+        // by more than DEPTH_JUMP within half a pixel).
+        let along = hit.n.dot(r.dir);
+        let on_plane = if along.abs() > 1e-12 {
+            (hit.n.dot(hit.p - r.origin) / along).max(0.0)
+        } else {
+            f64::INFINITY
+        };
         let (depth, vel) = match h {
             Some(h2)
-                if (h2.t - hit.t).abs() <= DEPTH_JUMP * hit.t
+                if (h2.t - on_plane).abs() <= DEPTH_JUMP * hit.t
                     && h2.n.dot(hit.n) >= CREASE_COS
                     && same_surface(world, hit, &h2) =>
             {

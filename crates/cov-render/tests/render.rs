@@ -289,3 +289,32 @@ fn a_mirror_shows_what_it_reflects() {
         }
     }
 }
+
+/// A plane seen at a grazing angle is no silhouette of itself: half a pixel away its depth
+/// changes by more than the silhouette threshold (7% here), but it continues the hit's
+/// tangent plane. Lit from below, both sides are dark, where an edge would count at full
+/// contrast: the floor's pixels must predict the pixel filter's own window and nothing
+/// more.
+#[test]
+fn a_plane_at_a_grazing_angle_is_no_silhouette() {
+    let text = r#"Scene(
+        camera: (position: (0.0, 1.0, 0.0), look_at: (0.0, 1.0, -1.0), fov: 40.0, width: 16, height: 16),
+        materials: { "floor": Diffuse(albedo: (0.5, 0.5, 0.5)) },
+        lights: [Sphere(center: (0.0, -2.0, -3.0), radius: 0.5, radiance: (5.0, 5.0, 5.0))],
+        shapes: [Quad(corner: (-50.0, 0.0, -50.0), edge_u: (100.0, 0.0, 0.0), edge_v: (0.0, 0.0, 50.0), material: "floor")],
+    )"#;
+    let world = World::from_text(text, "<test>", std::path::Path::new(".")).unwrap();
+    let maps = cov_render::covpass::covariance_rows(&world, 4, 1, 1, 1, 0..16, None).unwrap();
+    let f = cov_sensor::SensorParams::default().filter;
+    let own = 1.0 / (4.0 * std::f64::consts::PI.powi(2) * f * f);
+    // Rows 12 to 15 see the floor 3 to 6 m away, at 10° to 19° from grazing.
+    for y in 12..16 {
+        for x in 4..12 {
+            let s = maps.pixels[y * 16 + x].sigma;
+            assert!(
+                (s[0] - own).abs() < 1e-9 * own && (s[2] - own).abs() < 1e-9 * own,
+                "({x}, {y}): {s:?} against the pixel filter's {own}"
+            );
+        }
+    }
+}
