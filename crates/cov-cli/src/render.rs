@@ -46,9 +46,9 @@ pub struct RenderArgs {
     /// Side of the covariance grid's blocks (px): 1, 2, 4, 8 or 16.
     #[arg(long, default_value_t = 4)]
     pub cov_stride: u32,
-    /// Surface vertices each covariance path follows: 1 (camera → hit → light) to 2
-    /// (every vertex the path tracer samples).
-    #[arg(long, default_value_t = cov_render::MAX_DEPTH)]
+    /// Surface vertices each covariance path follows: 1 (camera → hit → light; the
+    /// default, measured better) to 2 (every vertex the path tracer samples).
+    #[arg(long, default_value_t = cov_render::DEFAULT_DEPTH)]
     pub cov_depth: u32,
     /// Seed of the random numbers (the image does not depend on the thread count).
     #[arg(long, default_value_t = 1)]
@@ -555,9 +555,9 @@ pub struct CheckArgs {
     /// Covariance paths per pixel.
     #[arg(long, default_value_t = 8)]
     pub cov_paths: u32,
-    /// Surface vertices each covariance path follows: 1 (camera → hit → light) to 2
-    /// (every vertex the path tracer samples).
-    #[arg(long, default_value_t = cov_render::MAX_DEPTH)]
+    /// Surface vertices each covariance path follows: 1 (camera → hit → light; the
+    /// default, measured better) to 2 (every vertex the path tracer samples).
+    #[arg(long, default_value_t = cov_render::DEFAULT_DEPTH)]
     pub cov_depth: u32,
     /// Render at this size instead of the scene's (`WIDTHxHEIGHT`).
     #[arg(long, value_parser = parse_size)]

@@ -18,8 +18,9 @@
 //!    the material's lobe, and the turn from the plane of incidence to the plane of the
 //!    outgoing ray; then the change of handedness and the texture), inside `Moving` when
 //!    the shape moves;
-//! 4. for a second vertex, travel back along the path to the first and the reflection
-//!    there, as in 3 (glossy inter-reflection: a glossy floor mirroring what stands on it);
+//! 4. for a second vertex (`depth` 2; the renderer's default is [`DEFAULT_DEPTH`], one),
+//!    travel back along the path to the first and the reflection there, as in 3 (glossy
+//!    inter-reflection: a glossy floor mirroring what stands on it);
 //! 5. travel to the camera, with a `Moving` `BlockerEdge` where auxiliary camera rays
 //!    around the pixel see a silhouette (a nearer surface or the background) in front of
 //!    or behind the hit, a crease or another material, its window weighed by the step's
@@ -235,6 +236,14 @@ fn texture_window(
 /// (camera → x₁ → light and camera → x₁ → x₂ → light, crate::trace). A deeper vertex
 /// would predict light the image does not have.
 pub const MAX_DEPTH: u32 = 2;
+
+/// Surface vertices a covariance path follows unless told otherwise: 1 (camera → x₁ →
+/// light). Measured, not chosen: following the second vertex as well made `cov` worse on
+/// the glossy scene, the one it was built for (relMSE at 4 spp 1.07e-2 → 3.37e-2 over three
+/// seeds and their maps; the Σ-only filters of `cov-filter` 11–42% worse at every budget),
+/// and did not pay on the other bundled scenes (docs/render-bench.md, "Following the second
+/// vertex"). Depth 2 stays available.
+pub const DEFAULT_DEPTH: u32 = 1;
 
 /// The footprints on a surface seen at distance `dist` along the path from the camera, at
 /// the cosine `cos_o` to the ray that leaves it, for a block of side `side` (px): half a
@@ -773,9 +782,10 @@ fn tile_rng(seed: u64, index: usize) -> rand_chacha::ChaCha8Rng {
 }
 
 /// Traces `paths` covariance paths (1 to [`MAX_COV_PATHS`]) per block of `stride × stride`
-/// pixels, jittered over the block and the shutter, each through up to [`MAX_DEPTH`]
-/// surface vertices ([`trace_path`]); every pixel of a block gets the block's
-/// radiance-weighted prediction over its paths' vertices. A coarser grid costs `stride²` times less; a block
+/// pixels, jittered over the block and the shutter, each through [`DEFAULT_DEPTH`]
+/// surface vertex ([`trace_path`]; [`covariance_rows`] takes the depth); every pixel of a
+/// block gets the block's radiance-weighted prediction over its paths' vertices. A
+/// coarser grid costs `stride²` times less; a block
 /// that holds an edge predicts for all its pixels the detail that its paths saw, so edges
 /// widen to the block, which narrows filters and raises densities near them
 /// (conservative).
@@ -791,7 +801,7 @@ pub fn covariance_maps(
     progress: crate::film::Progress<'_>,
 ) -> Result<CovMaps, crate::RenderError> {
     let rows = 0..world.camera.height;
-    covariance_rows(world, paths, stride, MAX_DEPTH, seed, rows, progress)
+    covariance_rows(world, paths, stride, DEFAULT_DEPTH, seed, rows, progress)
 }
 
 /// [`covariance_maps`] of the tiles whose first row lies in `rows` (a part of a render,

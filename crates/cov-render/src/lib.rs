@@ -64,7 +64,7 @@ pub mod trace;
 pub mod validate;
 pub mod world;
 
-pub use covpass::{CovMaps, MAX_COV_PATHS, MAX_DEPTH, covariance_maps};
+pub use covpass::{CovMaps, DEFAULT_DEPTH, MAX_COV_PATHS, MAX_DEPTH, covariance_maps};
 pub use error::RenderError;
 pub use film::{Image, MAX_SPP};
 pub use renderer::{Method, RenderSettings, Rendered, Renderer, render};

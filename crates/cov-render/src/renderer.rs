@@ -41,7 +41,7 @@ use glam::DVec3;
 
 use crate::RenderError;
 use crate::adaptive::{Guide, MAX_RATIO, allocate_floors, filter_area, relative_variance};
-use crate::covpass::{CovMaps, MAX_COV_PATHS, MAX_DEPTH, STRIDES, covariance_rows};
+use crate::covpass::{CovMaps, DEFAULT_DEPTH, MAX_COV_PATHS, MAX_DEPTH, STRIDES, covariance_rows};
 use crate::denoise::Denoise;
 use crate::film::{Film, Filter, Gaussian, Image, MAX_SPP, Progress};
 use crate::guard::{candidate, candidates, chosen_filters, guarded};
@@ -159,7 +159,7 @@ pub struct RenderSettings {
     /// Side of the covariance grid's blocks (px, one of [`STRIDES`]).
     pub cov_stride: u32,
     /// Surface vertices a covariance path follows (1 to [`MAX_DEPTH`], the path
-    /// tracer's; 1: camera → hit → light only).
+    /// tracer's; 1, [`DEFAULT_DEPTH`]: camera → hit → light only).
     pub cov_depth: u32,
     /// Every sample's luminance is clamped to this (colour scaled down); `∞` for an
     /// unbiased image. A finite clamp is biased: for measuring the spectrum of a reference
@@ -176,7 +176,7 @@ pub struct RenderSettings {
 
 impl Default for RenderSettings {
     /// Covariance tracing (`cov`) at 16 samples per pixel, seed 1, one pass, one
-    /// covariance path per 4×4 block, through every vertex the path tracer samples.
+    /// covariance path per 4×4 block, through [`DEFAULT_DEPTH`] surface vertex.
     fn default() -> RenderSettings {
         RenderSettings {
             method: Method::Cov,
@@ -185,7 +185,7 @@ impl Default for RenderSettings {
             time: None,
             cov_paths: 1,
             cov_stride: 4,
-            cov_depth: MAX_DEPTH,
+            cov_depth: DEFAULT_DEPTH,
             max_luminance: f64::INFINITY,
             denoise: Denoise::None,
             parts: 1,
