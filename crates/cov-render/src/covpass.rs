@@ -785,10 +785,9 @@ fn tile_rng(seed: u64, index: usize) -> rand_chacha::ChaCha8Rng {
 /// pixels, jittered over the block and the shutter, each through [`DEFAULT_DEPTH`]
 /// surface vertex ([`trace_path`]; [`covariance_rows`] takes the depth); every pixel of a
 /// block gets the block's radiance-weighted prediction over its paths' vertices. A
-/// coarser grid costs `stride²` times less; a block
-/// that holds an edge predicts for all its pixels the detail that its paths saw, so edges
-/// widen to the block, which narrows filters and raises densities near them
-/// (conservative).
+/// coarser grid costs `stride²` times less; a block that holds an edge predicts for all
+/// its pixels the detail that its paths saw, so edges widen to the block, which narrows
+/// filters and raises densities near them (conservative).
 ///
 /// # Errors
 /// `paths` or `stride` out of range ([`STRIDES`]); an operator that rejects what the scene
