@@ -219,17 +219,31 @@ fn texture_window(
         };
         [jgj(0, 0), jgj(0, 1), jgj(1, 1)]
     };
-    // The block predicts for all its pixels the sharpest detail found in it, along each
-    // axis of the ray's frame: the largest `sxx` and `syy` of the lookups (their
-    // correlations, which differ from lookup to lookup, are dropped).
-    let (mut sxx, mut syy) = (0.0f64, 0.0f64);
+    // The block predicts for all its pixels the sharpest detail found in it: the envelope
+    // of the lookups' spectra taken in the surface's own (u, v) frame, which does not turn
+    // from pixel to pixel as the ray's frame does near normal incidence (taken in the ray's
+    // frame, it made textures look smoother in a band of columns where that frame turns
+    // fast). Per axis the largest; the correlation is the lookups' mean correlation
+    // coefficient (1 for stripes everywhere the same way, 0 for a checker's two edges),
+    // scaled to the envelope, so the envelope stays positive semi-definite.
+    let (mut e, mut cross, mut norm) = ([0.0f64; 3], 0.0, 0.0);
     for m in tex.moments(hit.uv, band * per_m, region * per_m) {
-        let [xx, _, yy] = Texture::from_moments(m.mean, m.mean_sq, to_ray(m.grad))?.spectrum();
-        sxx = sxx.max(xx);
-        syy = syy.max(yy);
+        let [xx, xy, yy] = Texture::from_moments(m.mean, m.mean_sq, m.grad)?.spectrum();
+        e[0] = e[0].max(xx);
+        e[2] = e[2].max(yy);
+        cross += xy;
+        norm += (xx * yy).max(0.0).sqrt();
     }
-    let best = Some(Texture::new(sxx, 0.0, syy)?);
-    Ok(best)
+    let rho = if norm > 0.0 {
+        (cross / norm).clamp(-1.0, 1.0)
+    } else {
+        0.0
+    };
+    e[1] = rho * (e[0] * e[2]).sqrt();
+    let w = to_ray(e);
+    // Jᵀ E J of a rank-one envelope (stripes) can round `xy` past `√(xx·yy)`: onto the bound.
+    let bound = (w[0] * w[2]).max(0.0).sqrt();
+    Ok(Some(Texture::new(w[0], w[1].clamp(-bound, bound), w[2])?))
 }
 
 /// Surface vertices a covariance path follows at most: those of the path tracer's paths

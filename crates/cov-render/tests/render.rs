@@ -318,3 +318,40 @@ fn a_plane_at_a_grazing_angle_is_no_silhouette() {
         }
     }
 }
+
+/// A texture's spectrum does not depend on how the ray's frame is turned. Vertical stripes
+/// on a wall seen head-on, from a little above its middle: across a row the ray's frame
+/// (`x` in the plane of incidence) turns through 180° around the middle column, while the
+/// stripes' detail stays horizontal. Every pixel must predict horizontal detail and no
+/// vertical detail (Σ_yy below 1% of Σ_xx: perspective tilts the stripes by up to about 2°
+/// at the sides; Σ_xx still varies with where a pixel falls on the stripes). Taken in
+/// the ray's frame with its correlation dropped, the texture's spectrum was spread over
+/// both axes where that frame is turned: Σ_yy rose to Σ_xx's size and Σ_xx about halved.
+#[test]
+fn a_texture_does_not_turn_with_the_rays_frame() {
+    let text = r#"Scene(
+        camera: (position: (0.0, 0.3, 2.0), look_at: (0.0, 0.0, 0.0), fov: 30.0, width: 32, height: 16),
+        textures: { "stripes": Stripes(count: 60, duty: 0.5, a: (0.3, 0.3, 0.3), b: (0.9, 0.9, 0.9)) },
+        materials: { "wall": Diffuse(albedo: (1.0, 1.0, 1.0), texture: "stripes") },
+        lights: [Rect(corner: (-20.0, -20.0, 30.0), edge_u: (40.0, 0.0, 0.0), edge_v: (0.0, 40.0, 0.0), radiance: (1.0, 1.0, 1.0))],
+        shapes: [Quad(corner: (-6.0, -3.0, 0.0), edge_u: (0.0, 6.0, 0.0), edge_v: (12.0, 0.0, 0.0), material: "wall")],
+    )"#;
+    let world = World::from_text(text, "<test>", std::path::Path::new(".")).unwrap();
+    let maps = cov_render::covpass::covariance_rows(&world, 4, 1, 1, 1, 0..16, None).unwrap();
+    let f = cov_sensor::SensorParams::default().filter;
+    let own = 1.0 / (4.0 * std::f64::consts::PI.powi(2) * f * f);
+    let xx: Vec<f64> = (0..32 * 16).map(|i| maps.pixels[i].sigma[0] - own).collect();
+    let lo = xx.iter().fold(f64::INFINITY, |a, &v| a.min(v));
+    assert!(
+        lo > 0.0,
+        "every pixel sees the stripes: smallest Σ_xx above the filter's {lo}"
+    );
+    for (i, p) in maps.pixels.iter().enumerate() {
+        let yy = p.sigma[2] - own;
+        assert!(
+            yy.abs() < 1e-2 * xx[i],
+            "pixel {i}: Σ_yy {yy} beside Σ_xx {}",
+            xx[i]
+        );
+    }
+}
