@@ -57,7 +57,8 @@ pub struct BenchArgs {
     #[arg(long, value_delimiter = ',', default_values_t = [2.0, 4.0, 8.0, 16.0, 32.0])]
     pub budgets: Vec<f64>,
     /// Methods, comma-separated (default: all): uniform, gauss, variance, cov-density,
-    /// cov-filter, cov.
+    /// cov-filter, cov-unguarded, cov; each may be followed by +oidn or +oidn-color (a
+    /// build with `--features oidn`).
     #[arg(long, value_delimiter = ',')]
     pub methods: Vec<String>,
     /// Samples per pixel of the reference.

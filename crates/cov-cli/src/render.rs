@@ -406,6 +406,15 @@ fn render_one(
             format!(", denoising {:.2} s", r.timing.denoising)
         },
     ));
+    if r.image
+        .pixels
+        .iter()
+        .all(|p| p.x == 0.0 && p.y == 0.0 && p.z == 0.0)
+    {
+        out.push_str(
+            "warning: the image is black: no light reached the camera (a Rect light emits on the side of edge_u × edge_v)\n",
+        );
+    }
     let mut written = vec![output.to_path_buf(), png, aov];
     if renderer.maps().is_some() {
         written.extend([density, filter, json]);

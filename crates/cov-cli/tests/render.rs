@@ -73,14 +73,14 @@ fn bad_scene_files_give_one_positioned_line() {
             "8",
             "NaN",
             ok_shape,
-            ":4:54: must be finite and > 0, got NaN",
+            ":4:54: `radius` must be finite and > 0, got NaN",
         ),
         (
             "zero resolution",
             "0",
             "0.5",
             ok_shape,
-            ":2:85: must be 1 to 8192 px, got 0",
+            ":2:85: `width` must be 1 to 8192 px, got 0",
         ),
         (
             "unknown material",
@@ -309,4 +309,21 @@ fn denoise_with_oidn_writes_a_denoised_image() {
     let (noisy, _) = render("examples/scenes/cornell.ron", "noisy", &["--spp", "2"]);
     assert_ne!(pixels(&exr), pixels(&noisy));
     assert!(pixels(&exr).iter().all(|v| v.is_finite() && *v >= 0.0));
+}
+
+/// A scene whose only light faces away from everything renders black, and says why.
+#[test]
+fn a_black_image_says_so() {
+    let text = r#"Scene(
+    camera: (position: (0.0, 1.0, 3.0), look_at: (0.0, 1.0, 0.0), fov: 40.0, width: 8, height: 8),
+    materials: { "w": Diffuse(albedo: (0.5, 0.5, 0.5)) },
+    lights: [Rect(corner: (-0.5, 2.0, -0.5), edge_u: (0.0, 0.0, 1.0), edge_v: (1.0, 0.0, 0.0), radiance: (5.0, 5.0, 5.0))],
+    shapes: [Quad(corner: (-5.0, 0.0, -5.0), edge_u: (10.0, 0.0, 0.0), edge_v: (0.0, 0.0, 10.0), material: "w")],
+)"#;
+    let file = tmp("upward_light.ron");
+    std::fs::write(&file, text).expect("write scene");
+    let (_, stdout) = render(file.to_str().expect("utf-8"), "upward_light", &["--spp", "2"]);
+    assert!(stdout.contains("warning: the image is black"), "{stdout}");
+    let (_, stdout) = render("examples/scenes/cornell.ron", "not_black", &["--spp", "2"]);
+    assert!(!stdout.contains("warning"), "{stdout}");
 }

@@ -439,16 +439,72 @@ impl<'de, T: Deserialize<'de>> Deserialize<'de> for At<T> {
     }
 }
 
+/// The field whose value the parser refused at `line:col` (1-based, as it reports it) in
+/// `text`: the identifier before the `:` that precedes the value (a tuple is reported at
+/// its closing parenthesis, and its field precedes the opening one). `None` where the
+/// value is not a field's (an entry of a list).
+fn field_before(text: &str, line: usize, col: usize) -> Option<&str> {
+    let text = text.strip_prefix('\u{feff}').unwrap_or(text);
+    let start: usize = text
+        .split_inclusive('\n')
+        .take(line.checked_sub(1)?)
+        .map(str::len)
+        .sum();
+    let row = text.get(start..)?;
+    let at = row
+        .char_indices()
+        .nth(col.checked_sub(1)?)
+        .map_or(row.len(), |(i, _)| i);
+    let mut end = start + at;
+    // A tuple is refused at its closing parenthesis: its field precedes the opening one.
+    if text[end..].starts_with(')') {
+        let mut depth = 0usize;
+        for (i, c) in text[..=end].char_indices().rev() {
+            match c {
+                ')' => depth += 1,
+                '(' if depth == 1 => {
+                    end = i;
+                    break;
+                }
+                '(' => depth = depth.checked_sub(1)?,
+                _ => {}
+            }
+        }
+    }
+    let before = text.get(..end)?.trim_end().strip_suffix(':')?.trim_end();
+    let name_start = before
+        .char_indices()
+        .rev()
+        .take_while(|(_, c)| c.is_ascii_alphanumeric() || *c == '_')
+        .last()
+        .map(|(i, _)| i)?;
+    Some(&before[name_start..])
+}
+
 impl SceneFile {
     /// Parses scene text; `file` names it in errors.
     ///
     /// # Errors
     /// Malformed RON, unknown fields or variants, bad numbers: positioned.
     pub fn parse(text: &str, file: &str) -> Result<SceneFile, SceneError> {
-        Self::parse_probed(text, None).map_err(|e| SceneError {
-            file: file.to_string(),
-            at: Some((e.span.start.line, e.span.start.col)),
-            message: cov_core::one_line(&e.code.to_string()),
+        Self::parse_probed(text, None).map_err(|e| {
+            let (line, col) = (e.span.start.line, e.span.start.col);
+            let mut message = e.code.to_string();
+            // A value the checked types refused: name its field, as the user wrote it.
+            if let ron::Error::Message(m) = &e.code
+                && let Some(name) = field_before(text, line, col)
+            {
+                message = if m.starts_with("must be ") {
+                    format!("`{name}` {m}")
+                } else {
+                    format!("`{name}`: {m}")
+                };
+            }
+            SceneError {
+                file: file.to_string(),
+                at: Some((line, col)),
+                message: cov_core::one_line(&message),
+            }
         })
     }
 

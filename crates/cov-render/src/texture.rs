@@ -189,18 +189,23 @@ impl TextureMap {
         if !path.is_file() {
             return Err(format!("no such file: {}", one(&path.display())));
         }
-        let reader = image::ImageReader::open(path)
-            .and_then(|r| r.with_guessed_format())
-            .map_err(|e| one(&e))?;
-        let (w, h) = reader.into_dimensions().map_err(|e| one(&e))?;
+        // By content, then by extension; anything but PNG and EXR is named as such.
+        let open = || {
+            let r = image::ImageReader::open(path)
+                .and_then(|r| r.with_guessed_format())
+                .map_err(|e| one(&e))?;
+            match r.format() {
+                Some(image::ImageFormat::Png | image::ImageFormat::OpenExr) => Ok(r),
+                _ => Err("not a PNG or EXR image (the formats textures are read from)".to_string()),
+            }
+        };
+        let (w, h) = open()?.into_dimensions().map_err(|e| one(&e))?;
         if w == 0 || h == 0 || w > MAX_TEXTURE_SIDE || h > MAX_TEXTURE_SIDE {
             return Err(format!(
                 "the image is {w}x{h}; texture images are read up to {MAX_TEXTURE_SIDE} texels per side"
             ));
         }
-        let reader = image::ImageReader::open(path)
-            .and_then(|r| r.with_guessed_format())
-            .map_err(|e| one(&e))?;
+        let reader = open()?;
         let linear = matches!(reader.format(), Some(image::ImageFormat::OpenExr));
         let img = reader.decode().map_err(|e| one(&e))?.into_rgb32f();
         let srgb = |c: f32| {
@@ -592,6 +597,10 @@ mod tests {
         assert!(TextureMap::stripes(2, 1.0, DVec3::ZERO, DVec3::ONE, 8, DVec2::ONE).is_err());
         assert!(TextureMap::noise(2, 0, DVec3::ZERO, DVec3::ONE, MAX_TEXTURE_SIDE + 1, DVec2::ONE).is_err());
         assert!(TextureMap::load(Path::new("/nonexistent.png"), DVec2::ONE).is_err());
+        // A file that is no image says so, in its own words.
+        let this = Path::new(env!("CARGO_MANIFEST_DIR")).join("Cargo.toml");
+        let e = TextureMap::load(&this, DVec2::ONE).unwrap_err();
+        assert_eq!(e, "not a PNG or EXR image (the formats textures are read from)");
         // NaN and out-of-range texels are clamped, never passed on.
         let t = TextureMap::from_rgb(1, 1, vec![[f32::NAN, 2.0, -1.0]], DVec2::ONE).expect("ok");
         assert_eq!(t.rgb(DVec2::ZERO, 0.0), DVec3::new(0.0, 1.0, 0.0));

@@ -166,3 +166,25 @@ fn mutated_scenes_give_one_positioned_line() {
         }
     }
 }
+
+/// A value the parser refuses is named by its field, as the user wrote it.
+#[test]
+fn refused_values_name_their_field() {
+    let radius = scene(&[(
+        "SHAPE",
+        r#"Sphere(center: (0.0, 0.5, 0.0), radius: -0.1, material: "w")"#,
+    )]);
+    let e = error(&radius);
+    assert!(
+        e.starts_with("5:115: `radius` must be finite and > 0, got -0.1"),
+        "{e}"
+    );
+    let center = scene(&[(
+        "SHAPE",
+        r#"Sphere(center: (0.0, inf, 0.0), radius: 0.5, material: "w")"#,
+    )]);
+    let e = error(&center);
+    assert!(e.contains("`center`: a vector must be finite"), "{e}");
+    let fov = scene(&[("FOV", "-1.0")]);
+    assert!(error(&fov).contains("`fov`"), "{}", error(&fov));
+}
