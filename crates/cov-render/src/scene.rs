@@ -439,17 +439,23 @@ impl<'de, T: Deserialize<'de>> Deserialize<'de> for At<T> {
     }
 }
 
+/// The byte offset in `text` of line `line` (1-based).
+fn line_start(text: &str, line: usize) -> Option<usize> {
+    Some(
+        text.split_inclusive('\n')
+            .take(line.checked_sub(1)?)
+            .map(str::len)
+            .sum(),
+    )
+}
+
 /// The field whose value the parser refused at `line:col` (1-based, as it reports it) in
 /// `text`: the identifier before the `:` that precedes the value (a tuple is reported at
 /// its closing parenthesis, and its field precedes the opening one). `None` where the
 /// value is not a field's (an entry of a list).
 fn field_before(text: &str, line: usize, col: usize) -> Option<&str> {
     let text = text.strip_prefix('\u{feff}').unwrap_or(text);
-    let start: usize = text
-        .split_inclusive('\n')
-        .take(line.checked_sub(1)?)
-        .map(str::len)
-        .sum();
+    let start = line_start(text, line)?;
     let row = text.get(start..)?;
     let at = row
         .char_indices()
@@ -528,12 +534,7 @@ impl SceneFile {
             // the value starts at the next character that is not white space.
             Err(e) if e.code.to_string().contains(LOCATE_MARK) => {
                 let (mut line, mut col) = (e.span.start.line, e.span.start.col);
-                let start: usize = text
-                    .split_inclusive('\n')
-                    .take(line.checked_sub(1)?)
-                    .map(str::len)
-                    .sum();
-                let rest = text.get(start..)?;
+                let rest = text.get(line_start(text, line)?..)?;
                 for c in rest.chars().skip(col.saturating_sub(1)) {
                     match c {
                         '\n' => {
