@@ -321,8 +321,8 @@ fn a_plane_at_a_grazing_angle_is_no_silhouette() {
 
 /// A texture's spectrum does not depend on how the ray's frame is turned. Vertical stripes
 /// on a wall seen head-on, from a little above its middle: across a row the ray's frame
-/// (`x` in the plane of incidence) turns through 180° around the middle column, while the
-/// stripes' detail stays horizontal. Every pixel must predict horizontal detail and no
+/// (`x` in the plane of incidence) turns by about 120° (vertical in the middle column,
+/// about 60° from it at the sides), while the stripes' detail stays horizontal. Every pixel must predict horizontal detail and no
 /// vertical detail (Σ_yy below 1% of Σ_xx: perspective tilts the stripes by up to about 2°
 /// at the sides; Σ_xx still varies with where a pixel falls on the stripes). Taken in
 /// the ray's frame with its correlation dropped, the texture's spectrum was spread over
