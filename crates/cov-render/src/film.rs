@@ -316,10 +316,20 @@ impl Stencil {
         self.rows.clear();
         self.weights.clear();
         let ri = g.reach() as i64;
-        for dy in -ri..=ri {
+        // Rows 0 ..= ri from the Gaussian; row −dy is row dy reversed (w(−x, −dy) =
+        // w(x, dy), and the exponent is the same to the bit, so are its cells).
+        self.rows.resize(2 * ri as usize + 1, (0, 0..0));
+        for dy in 0..=ri {
             let k = self.weights.len();
             let first = g.row_weights(dy as f64, -ri, ri, &mut self.weights);
-            self.rows.push((first, k..self.weights.len()));
+            let n = self.weights.len() - k;
+            self.rows[(ri + dy) as usize] = (first, k..k + n);
+            if dy > 0 {
+                self.weights.extend_from_within(k..k + n);
+                self.weights[k + n..].reverse();
+                // The reversed run ends at −first.
+                self.rows[(ri - dy) as usize] = (1 - first - n as i64, k + n..k + 2 * n);
+            }
         }
         self.of = Some(*g);
     }
