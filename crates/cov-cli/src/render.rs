@@ -380,6 +380,10 @@ fn render_one(
             100.0 * r.timing.covariance / total.max(1e-9),
             s = maps.stride,
         ));
+    } else if r.method.uses_covariance() {
+        out.push_str(
+            "covariance: not traced (with a denoiser, Σ only allocates samples after a pilot, and this budget has none: below 3 spp)\n",
+        );
     }
     let n = f64::from(w) * f64::from(h);
     let reached = match a.time {

@@ -55,7 +55,8 @@ use crate::film::Progress;
 use crate::film::{Film, Image};
 use crate::guard::candidates;
 use crate::renderer::{
-    Method, RenderSettings, Renderer, Sampled, Timing, Window, part_rows, reconstruct, timed,
+    Method, RenderSettings, Renderer, Sampled, Timing, Window, part_rows, reads_covariance, reconstruct,
+    timed,
 };
 use crate::{RenderError, World};
 
@@ -139,7 +140,7 @@ impl Renderer<'_> {
         }
         let win = part.window(self.world.camera.height)?;
         let Sampled { film, timing, .. } = self.sample(&win, progress)?;
-        if self.settings().method.uses_covariance() && self.maps().is_none() {
+        if self.reads_guide() && self.maps().is_none() {
             // A guide given to the renderer has no maps for the part file to carry.
             return Err(RenderError::Parts(
                 "a part traces its own covariance pass: render it without a given guide".into(),
@@ -288,7 +289,7 @@ impl PartFilm {
             normal: crop(&film.normal, w, &rows),
             depth: crop(&film.depth, w, &rows),
         };
-        let uses = settings.method.uses_covariance();
+        let uses = reads_covariance(settings.method, settings.denoise, settings.spp, false);
         PartFilm {
             key: PartKey::new(world, settings),
             part,
@@ -508,7 +509,10 @@ impl PartFilm {
         }
         let method = Method::from_name(&key.method)
             .ok_or_else(|| bad(format!("an unknown method `{}`", crate::echo(&key.method))))?;
-        let layers = if method.uses_covariance() { 2 } else { 1 };
+        let denoise = Denoise::from_name(&key.denoise)
+            .ok_or_else(|| bad(format!("an unknown denoiser `{}`", crate::echo(&key.denoise))))?;
+        let reads = reads_covariance(method, denoise, key.spp, false);
+        let layers = if reads { 2 } else { 1 };
         let (w, h) = (key.width as usize, rows.len());
         if meta.headers.len() != layers
             || meta.headers.iter().any(|hd| {
@@ -565,7 +569,7 @@ impl PartFilm {
                 set(&mut film, i, v);
             }
         }
-        let maps = if method.uses_covariance() {
+        let maps = if reads {
             let cl = layer("cov")?;
             let mut m = vec![PixelCov::default(); w * h];
             for (name, _, set) in MAP_FIELDS {
@@ -680,7 +684,7 @@ pub fn merge(parts: &[PartFilm]) -> Result<Merged, RenderError> {
         }
     }
     let mut timing = Timing::default();
-    let maps = method.uses_covariance().then_some(CovMaps {
+    let maps = reads_covariance(method, denoise, key.spp, false).then_some(CovMaps {
         width: w,
         height: h,
         pixels,
@@ -690,7 +694,8 @@ pub fn merge(parts: &[PartFilm]) -> Result<Merged, RenderError> {
     });
     let (guide, secs) = timed(|| maps.as_ref().map(|m| Guide::new(m, 0.0)));
     let cands = match (&guide, method) {
-        (Some(g), Method::Cov) => candidates(g, 0..h),
+        // A denoiser reconstructs from the box image: the guard's candidates go unused.
+        (Some(g), Method::Cov) if denoise == Denoise::None => candidates(g, 0..h),
         _ => Vec::new(),
     };
     timing.reconstruction += secs;

@@ -400,7 +400,7 @@ impl<'w> Renderer<'w> {
                 .filter(|t| r.contains(&t.1))
                 .count()
         };
-        let cov = if s.method.uses_covariance() && !self.guide_given && !self.has_maps(&win.guide) {
+        let cov = if self.reads_guide() && !self.guide_given && !self.has_maps(&win.guide) {
             tiles(&win.guide)
         } else {
             0
@@ -411,6 +411,13 @@ impl<'w> Renderer<'w> {
             0
         };
         cov + pilot + tiles(&win.owned)
+    }
+
+    /// Whether this render reads the covariance pass ([`reads_covariance`] of its
+    /// settings).
+    pub fn reads_guide(&self) -> bool {
+        let s = &self.settings;
+        reads_covariance(s.method, s.denoise, s.spp, s.time.is_some())
     }
 
     /// Whether maps of `rows` exist.
@@ -449,14 +456,11 @@ impl<'w> Renderer<'w> {
     pub(crate) fn sample(&mut self, win: &Window, progress: Progress<'_>) -> Result<Sampled, RenderError> {
         let start = Instant::now();
         let method = self.settings.method;
-        if method.uses_covariance() && !self.guide_given {
+        let reads_guide = self.reads_guide();
+        if reads_guide && !self.guide_given {
             self.trace_rows(win.guide.clone(), progress)?;
         }
-        let guide = if method.uses_covariance() {
-            self.guide.as_ref()
-        } else {
-            None
-        };
+        let guide = if reads_guide { self.guide.as_ref() } else { None };
         let mut timing = Timing {
             covariance: guide.map_or(0.0, |g| g.secs),
             ..Timing::default()
@@ -746,6 +750,18 @@ pub(crate) fn reconstruct(
     })
 }
 
+/// Whether a render of `method` followed by `denoise` at `spp` (`time_limited`: with
+/// [`RenderSettings::time`]) reads the covariance pass. Covariance tracing followed by a
+/// denoiser reads Σ only to allocate samples after a pilot: at a budget too small for one
+/// (below 3 spp, without a time limit) the pass and the guard's candidates would go
+/// unused, so they are neither made nor timed, and the render is uniform sampling's with
+/// its denoiser.
+pub fn reads_covariance(method: Method, denoise: Denoise, spp: f64, time_limited: bool) -> bool {
+    let unread =
+        method == Method::Cov && denoise != Denoise::None && variance_pilot(spp).is_none() && !time_limited;
+    method.uses_covariance() && !unread
+}
+
 /// The variance method's pilot: a quarter of the budget, at least 2 samples per pixel
 /// (for a variance); `None` when the budget leaves nothing after it (one uniform pass).
 fn variance_pilot(spp: f64) -> Option<u32> {
@@ -802,5 +818,25 @@ impl Timing {
     fn sample(&mut self, f: impl FnOnce()) {
         let ((), secs) = timed(f);
         self.sampling += secs;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Only covariance tracing followed by a denoiser, with no pilot and no time limit,
+    /// leaves Σ unread.
+    #[test]
+    fn what_reads_the_covariance_pass() {
+        let (cov, oidn, none) = (Method::Cov, Denoise::Oidn, Denoise::None);
+        assert!(!reads_covariance(cov, oidn, 1.0, false));
+        assert!(!reads_covariance(cov, Denoise::OidnColor, 2.0, false));
+        assert!(reads_covariance(cov, oidn, 3.0, false));
+        assert!(reads_covariance(cov, oidn, 2.0, true));
+        assert!(reads_covariance(cov, none, 1.0, false));
+        assert!(reads_covariance(Method::CovFilter, oidn, 2.0, false));
+        assert!(reads_covariance(Method::CovDensity, oidn, 2.0, false));
+        assert!(!reads_covariance(Method::Uniform, none, 16.0, false));
     }
 }

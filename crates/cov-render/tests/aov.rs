@@ -173,3 +173,35 @@ fn the_denoiser_receives_the_box_image_of_the_guarded_samples() {
     assert_eq!(denoised.image.digest(), want.digest());
     assert_ne!(denoised.image.digest(), plain.image.digest());
 }
+
+/// Below 3 spp covariance tracing followed by the denoiser has no pilot to allocate
+/// from, so nothing reads Σ: the pass is not traced or timed, and the render is uniform
+/// sampling's with the denoiser, bit for bit.
+#[cfg(feature = "oidn")]
+#[test]
+fn a_denoised_render_without_a_pilot_traces_no_pass() {
+    let world = cornell(64, 48);
+    for spp in [1.0, 2.0] {
+        let s = RenderSettings {
+            method: Method::Cov,
+            spp,
+            denoise: Denoise::Oidn,
+            ..RenderSettings::default()
+        };
+        let mut r = Renderer::new(&world, s).unwrap();
+        let cov = r.render(None).unwrap();
+        assert!(r.maps().is_none() && cov.timing.covariance == 0.0, "{spp} spp");
+        let uniform = render_with(&world, Method::Uniform, spp, Denoise::Oidn);
+        assert_eq!(cov.image.digest(), uniform.image.digest(), "{spp} spp");
+    }
+    // From 3 spp the pilot allocates from Σ.
+    let s = RenderSettings {
+        method: Method::Cov,
+        spp: 3.0,
+        denoise: Denoise::Oidn,
+        ..RenderSettings::default()
+    };
+    let mut r = Renderer::new(&world, s).unwrap();
+    r.render(None).unwrap();
+    assert!(r.maps().is_some());
+}

@@ -3,6 +3,7 @@
 
 use std::path::{Path, PathBuf};
 
+use cov_render::denoise::Denoise;
 use cov_render::parts::{Part, PartFilm, merge};
 use cov_render::{Method, RenderSettings, Renderer, World};
 
@@ -93,6 +94,24 @@ fn merged_parts_are_the_single_render() {
                     method.name()
                 );
             }
+        }
+    }
+}
+
+/// Covariance tracing followed by a denoiser below 3 spp reads no Σ (no pilot): its parts
+/// carry no maps, their files read back, and from 3 spp they carry them again. (Merging
+/// denoises, which needs the `oidn` feature; the renderer's own test covers the image.)
+#[test]
+fn parts_without_a_pilot_carry_no_maps() {
+    let world = scene("cornell.ron", 32, 48);
+    for (spp, maps) in [(2.0, false), (3.0, true)] {
+        let s = RenderSettings {
+            spp,
+            denoise: Denoise::Oidn,
+            ..settings(Method::Cov, 5)
+        };
+        for p in parts(&world, &s, 2, &format!("denoised-{spp}")) {
+            assert_eq!(p.maps.is_some(), maps, "{spp} spp, part {}", p.part);
         }
     }
 }
