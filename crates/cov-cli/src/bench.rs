@@ -299,7 +299,8 @@ pub fn bench(a: &BenchArgs) -> Result<String, String> {
         ..RenderSettings::default()
     };
     // Every run goes through the library's renderer, with a covariance guide traced here
-    // (its time is added to every covariance run).
+    // (its time is added to every covariance run that reads it: not to `cov` followed by a
+    // denoiser below 3 spp, which has no pilot, `cov_render::renderer::reads_covariance`).
     let run = |m: Variant, budget: f64, guide: Option<&Guide>, seed: u64| -> Result<Rendered, String> {
         let mut r = Renderer::new(&world, settings(m, budget, seed)).map_err(|e| e.to_string())?;
         if let Some(g) = guide {
@@ -316,8 +317,8 @@ pub fn bench(a: &BenchArgs) -> Result<String, String> {
         .collect();
     // The covariance pass, once per repeat with that repeat's seed: the map is part of
     // the method's randomness (one path per block is a noisy estimate), so the repeats
-    // average over maps too. Its fastest time is added to every covariance run (the pass
-    // does not depend on the budget).
+    // average over maps too. Its fastest time is added to every covariance run that reads
+    // it (the pass does not depend on the budget).
     let guides: Vec<Guide> = if methods.iter().any(|m| m.uses_covariance()) {
         let mut guides = Vec::with_capacity(seeds.len());
         for &seed in &seeds {

@@ -59,7 +59,8 @@ enum Command {
     RenderCheck(crate::render::CheckArgs),
     /// Render a scene (RON) with covariance tracing (by default; --method picks another
     /// method): the covariance pass, samples where it predicts detail, per-pixel filters
-    /// from Σ; writes the image (EXR and PNG) and the density and filter maps.
+    /// from Σ; writes the image (EXR and PNG) and, when the pass runs, the density and
+    /// filter maps.
     Render(crate::render::RenderArgs),
     /// Merge the parts of a render (`covtrace render --part I/N`) into its image: the
     /// single-process render's, bit for bit; writes what `render` writes.

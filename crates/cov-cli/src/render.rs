@@ -33,7 +33,8 @@ pub struct RenderArgs {
     pub time: Option<f64>,
     /// Denoise the image with Intel Open Image Denoise: oidn (guided by the first hit's
     /// albedo and normal) or oidn-color (the colour alone); with --method cov the denoiser
-    /// receives the box image of the samples the guard allocated. Needs a build with
+    /// receives the box image of the samples the guard allocated (below 3 spp, with no
+    /// pilot, uniform samples and no covariance pass). Needs a build with
     /// `--features oidn` (docs/oidn.md).
     #[arg(long, value_parser = parse_denoise, default_value = "none")]
     pub denoise: Denoise,

@@ -137,7 +137,7 @@ const CLAMP_TILE: i64 = 4;
 /// filter stops short of an edge the covariance pass saw a few pixels away. Each std
 /// becomes `min(s_p, min_q max(s_q, d(p, q) / EDGE_REACH))` over every pixel `q`.
 ///
-/// The minimum is taken over tiles of [`CLAMP_TILE`] pixels first: a tile whose smallest
+/// The minimum is taken over tiles of 4×4 pixels first: a tile whose smallest
 /// std and nearest pixel cannot lower the limit is skipped, and a tile of one std
 /// contributes `max(s, d_nearest / EDGE_REACH)` without visiting its pixels. Both give
 /// the per-pixel minimum bit for bit (`max` and `min` are exact, and the distances are
@@ -323,8 +323,9 @@ mod tests {
 
     /// The clamp is the definition taken over every pixel of the image: each filter's
     /// std becomes min(its std, min over pixels q of max(std_q, d(p, q) / EDGE_REACH)),
-    /// bit for bit, on fields of random blocks (aligned with the clamp's tiles, as the
-    /// covariance grid's are, and not), steps and isolated narrow pixels.
+    /// bit for bit, on fields of random stds, steps, isolated narrow pixels, and blocks of
+    /// one filter each (aligned with the clamp's 4×4 tiles, as the covariance grid's are,
+    /// and not).
     #[test]
     fn edge_clamp_is_its_definition() {
         let (w, h) = (37u32, 29u32);
@@ -364,6 +365,11 @@ mod tests {
                         6 => blocks[(y / 4 * w + x / 4) as usize],
                         _ => blocks[(y / 5 * w + x / 3) as usize],
                     };
+                    // Blocks of one filter each, as the covariance grid's are: the clamp's
+                    // tiles of one std (its closed form) among them.
+                    if field >= 6 {
+                        return Gaussian::from_cov([s * s, 0.2 * s * s, 0.6 * s * s]);
+                    }
                     Gaussian::from_cov([s * s, 0.3 * s * s * rnd(), s * s * (0.5 + 0.5 * rnd())])
                 })
                 .collect();

@@ -26,8 +26,9 @@
 //! variance of the pixel's luminance over its count; it overstates the variance of a
 //! quasi-Monte Carlo mean, which makes the box look worse than it is, so the guard leans
 //! towards filtering where it cannot tell. A pixel with a single sample has no sample
-//! variance; it takes its neighbourhood's noise ([`one_sample_variance`]). The estimates are relative (divided by the
-//! squared 3×3 mean luminance plus [`crate::metrics::REL_EPS`], the error the benchmarks
+//! variance; it takes its neighbourhood's noise (the least, over four directions, of the
+//! neighbouring pixels' squared differences; see `one_sample_variance`). The estimates are
+//! relative (divided by the squared 3×3 mean luminance plus [`crate::metrics::REL_EPS`], the error the benchmarks
 //! report) and averaged over 3×3 pixels before each pixel picks the smallest: one pixel's
 //! squared residual is too noisy to decide alone (Stein's unbiased risk estimate, tried
 //! for the same choice, needs the variance of the estimate itself, which is as noisy).
@@ -157,7 +158,7 @@ fn choose(
             c => luminance(film.reflected[i] / f64::from(c)),
         })
         .collect();
-    let var = one_sample_variance(film, &lx);
+    let var = one_sample_variance(film);
     let s2: Vec<f64> = (0..n).map(|i| var[i] / f64::from(film.count[i].max(1))).collect();
     // The variance of the pixel's mean at the target count.
     let s2_target: Vec<f64> = (0..n)
@@ -224,17 +225,18 @@ const LEAST_OF_FOUR: f64 = 0.535;
 ///
 /// A pixel with one sample (a budget of 1 spp) has no variance of its own; 0 would make
 /// the box look exact everywhere, and the guard a costly box. It takes the noise of its
-/// neighbourhood instead: independent noise makes neighbouring means differ alike in every
-/// direction, `E[(x_a − x_b)²] = 2σ²` where the image is flat, while an edge or a texture
-/// adds its variation to the directions that cross it. So, per direction (rows, columns
-/// and the two diagonals), half the mean squared difference of neighbouring pixels within
-/// [`ONE_SAMPLE_REACH`] of the pixel, and the least of the four: along an edge, the
-/// direction that does not cross it, over [`LEAST_OF_FOUR`]. Measured against the
+/// neighbourhood instead: independent noise makes neighbouring means (of the samples'
+/// luminance, as the pixel's own variance reads) differ alike in every direction,
+/// `E[(x_a − x_b)²] = σ² (1/n_a + 1/n_b)` where the image is flat, while an edge or a
+/// texture adds its variation to the directions that cross it. So, per direction (rows,
+/// columns and the two diagonals), the mean of `(x_a − x_b)² / (1/n_a + 1/n_b)` over
+/// neighbouring pixels within [`ONE_SAMPLE_REACH`] of the pixel, and the least of the
+/// four (along an edge, the direction that does not cross it), over [`LEAST_OF_FOUR`]. Measured against the
 /// alternatives (docs/render-bench.md): the sample variance of the 3×3 means counts a
 /// texture the pass did not see as noise and blurs it (2.4× uniform sampling's error on a
 /// blind checker at 1 spp, against 1.1× with this), and the median absolute deviation
 /// misses the heavy tail of path-traced noise.
-fn one_sample_variance(film: &Film, lx: &[f64]) -> Vec<f64> {
+fn one_sample_variance(film: &Film) -> Vec<f64> {
     const R: i64 = ONE_SAMPLE_REACH;
     let own = film.variance();
     let (w, h) = (film.width as i64, film.height as i64);
@@ -245,9 +247,16 @@ fn one_sample_variance(film: &Film, lx: &[f64]) -> Vec<f64> {
                 return own[i as usize];
             }
             let (x, y) = (i % w, i / w);
+            // A neighbour's mean luminance (the same samples' luminance as `own`'s) and
+            // the inverse of its count: two means of `a` and `b` samples differ by
+            // `σ² (1/a + 1/b)` in expectation where the image is flat.
             let at = |xx: i64, yy: i64| {
+                let j = (yy * w + xx) as usize;
                 let inside = xx >= 0 && yy >= 0 && xx < w && yy < h;
-                (inside && film.count[(yy * w + xx) as usize] > 0).then(|| lx[(yy * w + xx) as usize])
+                (inside && film.count[j] > 0).then(|| {
+                    let n = f64::from(film.count[j]);
+                    (film.lum[j][0] / n, 1.0 / n)
+                })
             };
             let mut best = f64::INFINITY;
             for (dx, dy) in [(1, 0), (0, 1), (1, 1), (1, -1)] {
@@ -258,14 +267,14 @@ fn one_sample_variance(film: &Film, lx: &[f64]) -> Vec<f64> {
                         if (qx - x).abs() > R || (qy - y).abs() > R {
                             continue;
                         }
-                        if let (Some(a), Some(b)) = (at(xx, yy), at(qx, qy)) {
-                            sum += (a - b).powi(2);
+                        if let (Some((a, ia)), Some((b, ib))) = (at(xx, yy), at(qx, qy)) {
+                            sum += (a - b).powi(2) / (ia + ib);
                             k += 1.0;
                         }
                     }
                 }
                 if k >= 2.0 {
-                    best = best.min(0.5 * sum / k);
+                    best = best.min(sum / k);
                 }
             }
             // No two neighbours with samples (an image of one pixel): nothing to tell.
@@ -306,7 +315,7 @@ mod tests {
 
     /// A film of one sample per pixel whose luminance is `f(x, y)` (grey radiance; the
     /// luminance of grey `v` is `v`).
-    fn one_sample(w: u32, h: u32, f: impl Fn(u32, u32) -> f64) -> (Film, Vec<f64>) {
+    fn one_sample(w: u32, h: u32, f: impl Fn(u32, u32) -> f64) -> Film {
         let mut film = Film::new(w, h);
         for y in 0..h {
             for x in 0..w {
@@ -317,10 +326,7 @@ mod tests {
                 film.lum[i] = [v, v * v];
             }
         }
-        let lx = (0..(w * h) as usize)
-            .map(|i| luminance(film.reflected[i]))
-            .collect();
-        (film, lx)
+        film
     }
 
     /// One sample per pixel: a clean step reads as no noise beside it (the direction
@@ -328,8 +334,8 @@ mod tests {
     /// variance ([`LEAST_OF_FOUR`] corrects the least of four directions).
     #[test]
     fn one_sample_variance_reads_noise_not_edges() {
-        let (film, lx) = one_sample(32, 32, |x, _| if x < 16 { 0.2 } else { 1.0 });
-        let v = one_sample_variance(&film, &lx);
+        let film = one_sample(32, 32, |x, _| if x < 16 { 0.2 } else { 1.0 });
+        let v = one_sample_variance(&film);
         for y in 1..31 {
             for x in 14..18 {
                 assert_eq!(v[y * 32 + x], 0.0, "({x}, {y})");
@@ -344,18 +350,38 @@ mod tests {
                 (-2.0 * u.ln()).sqrt() * (std::f64::consts::TAU * v).cos()
             })
             .collect();
-        let (film, lx) = one_sample(n as u32, n as u32, |x, y| {
+        let film = one_sample(n as u32, n as u32, |x, y| {
             1.0 + 0.1 * gauss[(y * n as u32 + x) as usize]
         });
-        let v = one_sample_variance(&film, &lx);
+        let v = one_sample_variance(&film);
         let mean = v.iter().sum::<f64>() / v.len() as f64;
         // Unit-variance noise scaled by 0.1: the estimates' mean is its variance.
         assert!((mean / 0.01 - 1.0).abs() < 0.02, "{mean} against 0.01");
+        // Neighbours of two samples (a budget between 1 and 2 spp): their means are half
+        // as noisy, and each difference is weighed by its pair's counts.
+        let mut mixed = film.clone();
+        for y in 0..n {
+            for x in (y % 2..n).step_by(2) {
+                let i = y * n + x;
+                mixed.count[i] = 2;
+                mixed.lum[i][0] = 2.0 * (1.0 + 0.1 * gauss[i] / 2f64.sqrt());
+            }
+        }
+        let v = one_sample_variance(&mixed);
+        let ones: Vec<f64> = (0..n * n)
+            .filter(|&i| mixed.count[i] == 1)
+            .map(|i| v[i])
+            .collect();
+        let mean = ones.iter().sum::<f64>() / ones.len() as f64;
+        assert!(
+            (mean / 0.01 - 1.0).abs() < 0.05,
+            "{mean} against 0.01 (mixed counts)"
+        );
         // From two samples on, a pixel keeps its own sample variance.
         let mut film = film;
         film.count[100] = 2;
         film.lum[100] = [2.0, 2.5];
-        let v = one_sample_variance(&film, &lx);
+        let v = one_sample_variance(&film);
         assert_eq!(v[100], film.variance()[100]);
         assert!((v[100] - 0.5).abs() < 1e-12);
     }

@@ -61,8 +61,9 @@ use crate::renderer::{
 use crate::{RenderError, World};
 
 pub use crate::renderer::MAX_PARTS;
-/// Version of the part file's layout and key.
-pub const FORMAT: u32 = 2;
+/// Version of the part file's layout and key (3: covariance tracing followed by a
+/// denoiser below 3 spp carries no covariance layer).
+pub const FORMAT: u32 = 3;
 /// Most channels a part file may hold (the film's 32 and the maps' 10 fit).
 const MAX_CHANNELS: usize = 64;
 

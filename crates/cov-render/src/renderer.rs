@@ -74,7 +74,9 @@ pub enum Method {
     /// over the square root of the pixels the guarded filter averages; the guarded
     /// reconstruction. Followed by a denoiser, the denoiser receives the box image
     /// instead: the guard then decides where samples go, the denoiser how they are
-    /// reconstructed (a Σ-filtered input measured worse, docs/oidn.md).
+    /// reconstructed (a Σ-filtered input measured worse, docs/oidn.md); below 3 spp there
+    /// is no pilot, so the samples are uniform and no pass is traced
+    /// ([`reads_covariance`]).
     Cov,
 }
 
@@ -133,7 +135,8 @@ impl Method {
         }
     }
 
-    /// Whether it needs the covariance pass.
+    /// Whether it is a covariance method, one that traces the covariance pass unless
+    /// nothing reads it ([`reads_covariance`]).
     pub fn uses_covariance(self) -> bool {
         matches!(
             self,
@@ -313,7 +316,8 @@ impl<'w> Renderer<'w> {
 
     /// Uses `guide` (made from this world's covariance maps at the same resolution, by
     /// another renderer or an earlier run) instead of tracing the pass again; its time
-    /// is counted in every render's [`Timing::covariance`].
+    /// is counted in the [`Timing::covariance`] of every render that reads it
+    /// ([`Renderer::reads_guide`]).
     ///
     /// # Errors
     /// A guide of another size.
@@ -378,7 +382,7 @@ impl<'w> Renderer<'w> {
             cands,
         } = self.sample(&win, progress)?;
         let method = self.settings.method;
-        let guide = self.guide.as_ref().filter(|_| method.uses_covariance());
+        let guide = self.guide.as_ref().filter(|_| self.reads_guide());
         let image = reconstruct(method, guide, &cands, &film, self.settings.denoise, &mut timing)?;
         Ok(Rendered {
             method,
@@ -832,6 +836,7 @@ mod tests {
         let (cov, oidn, none) = (Method::Cov, Denoise::Oidn, Denoise::None);
         assert!(!reads_covariance(cov, oidn, 1.0, false));
         assert!(!reads_covariance(cov, Denoise::OidnColor, 2.0, false));
+        assert!(!reads_covariance(cov, oidn, 2.9, false));
         assert!(reads_covariance(cov, oidn, 3.0, false));
         assert!(reads_covariance(cov, oidn, 2.0, true));
         assert!(reads_covariance(cov, none, 1.0, false));
