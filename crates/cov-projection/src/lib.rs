@@ -148,7 +148,9 @@ impl Project {
                 expected: "orthogonal to dir".into(),
             });
         }
-        let cos = dir.dot(normal).abs();
+        // Unit vectors' dot product rounds up to a few ulp above 1 at head-on incidence
+        // (for about one normalised vector in five, `v · v > 1`): still `|cos θ| = 1`.
+        let cos = dir.dot(normal).abs().min(1.0);
         let frame_y = dir.cross(frame_x);
         let p = normal - normal.dot(dir) * dir;
         // At (near-)normal incidence every transverse axis is in the plane of incidence.

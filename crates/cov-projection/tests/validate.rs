@@ -88,3 +88,20 @@ fn grazing_and_bad_parameters() {
     let mut flat = Cov::<2>::gaussian([0.1, 0.1]).unwrap();
     assert!(Operator::apply(&Project::with_angle(0.5, 0.3).unwrap(), &mut flat).is_err());
 }
+
+/// Head-on incidence with normalised vectors: `dir · normal` can round to just above 1
+/// (for about one normalised vector in five, `v · v > 1`), which is still `|cos θ| = 1`.
+#[test]
+fn head_on_incidence_is_cos_one() {
+    for k in 0..200 {
+        let a = 0.37 * f64::from(k);
+        let dir = DVec3::new(a.sin() * 0.7, a.cos(), 0.3 + 0.01 * f64::from(k)).normalize();
+        let fx = dir.any_orthonormal_vector();
+        for normal in [dir, -dir] {
+            let p = Project::from_vectors(dir, fx, normal)
+                .unwrap_or_else(|e| panic!("{dir:?} ({}): {e}", dir.dot(dir)));
+            assert!((p.cos() - 1.0).abs() <= 1e-15, "{}", p.cos());
+            assert_eq!(p.angle(), 0.0);
+        }
+    }
+}
