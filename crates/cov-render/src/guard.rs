@@ -27,9 +27,10 @@
 //! quasi-Monte Carlo mean, which makes the box look worse than it is, so the guard leans
 //! towards filtering where it cannot tell. A pixel with a single sample has no sample
 //! variance; it takes its neighbourhood's noise (the least, over four directions, of the
-//! neighbouring pixels' squared differences; see `one_sample_variance`). The estimates are
-//! relative (divided by the squared 3×3 mean luminance plus [`crate::metrics::REL_EPS`], the error the benchmarks
-//! report) and averaged over 3×3 pixels before each pixel picks the smallest: one pixel's
+//! neighbouring pixels' squared differences; see `one_sample_variance`). The estimates
+//! are relative (divided by the squared 3×3 mean luminance plus
+//! [`crate::metrics::REL_EPS`], the error the benchmarks report) and averaged over 3×3
+//! pixels before each pixel picks the smallest: one pixel's
 //! squared residual is too noisy to decide alone (Stein's unbiased risk estimate, tried
 //! for the same choice, needs the variance of the estimate itself, which is as noisy).
 //!
@@ -215,8 +216,8 @@ fn choose(
 const ONE_SAMPLE_REACH: i64 = 1;
 /// The expectation of [`one_sample_variance`]'s least directional estimate over the
 /// variance, for independent Gaussian noise (the least of four noisy estimates is low):
-/// measured on 65,536 pixels of it by the unit test `one_sample_variance_reads_noise_not_edges`
-/// (uniform noise reads 0.505). The estimate is divided by it, so that flat noise reads as
+/// measured on 65,536 pixels of it by the unit test
+/// `one_sample_variance_reads_noise_not_edges` (uniform noise reads 0.505). The estimate is divided by it, so that flat noise reads as
 /// its variance, as a pixel's own sample variance does.
 const LEAST_OF_FOUR: f64 = 0.535;
 
@@ -231,11 +232,11 @@ const LEAST_OF_FOUR: f64 = 0.535;
 /// texture adds its variation to the directions that cross it. So, per direction (rows,
 /// columns and the two diagonals), the mean of `(x_a − x_b)² / (1/n_a + 1/n_b)` over
 /// neighbouring pixels within [`ONE_SAMPLE_REACH`] of the pixel, and the least of the
-/// four (along an edge, the direction that does not cross it), over [`LEAST_OF_FOUR`]. Measured against the
-/// alternatives (docs/render-bench.md): the sample variance of the 3×3 means counts a
-/// texture the pass did not see as noise and blurs it (2.4× uniform sampling's error on a
-/// blind checker at 1 spp, against 1.1× with this), and the median absolute deviation
-/// misses the heavy tail of path-traced noise.
+/// four (along an edge, the direction that does not cross it), over [`LEAST_OF_FOUR`].
+/// Measured against the alternatives (docs/render-bench.md): the sample variance of the
+/// 3×3 means counts a texture the pass did not see as noise and blurs it (2.4× uniform
+/// sampling's error on a blind checker at 1 spp, against 1.1× with this), and the median
+/// absolute deviation misses the heavy tail of path-traced noise.
 fn one_sample_variance(film: &Film) -> Vec<f64> {
     const R: i64 = ONE_SAMPLE_REACH;
     let own = film.variance();
