@@ -128,8 +128,8 @@ fn around(w: i64, h: i64, i: i64, r: i64) -> impl Iterator<Item = (usize, i64)> 
     })
 }
 
-/// Side (px) of the tiles [`edge_clamp`] prunes with: the covariance grid's default block,
-/// over which the matched filters are constant.
+/// Side (px) of the tiles [`edge_clamp`] prunes with: the covariance grid's default block
+/// (where its filters are one per block, a tile takes the clamp's closed form).
 const CLAMP_TILE: i64 = 4;
 
 /// Narrows every filter so that it does not reach, at [`EDGE_REACH`] of its own std, a

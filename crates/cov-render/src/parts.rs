@@ -224,6 +224,18 @@ impl PartKey {
         }
     }
 
+    /// The method and the denoiser the key names.
+    ///
+    /// # Errors
+    /// A name this covtrace does not know, as a message.
+    fn method_and_denoiser(&self) -> Result<(Method, Denoise), String> {
+        let method = Method::from_name(&self.method)
+            .ok_or_else(|| format!("an unknown method `{}`", crate::echo(&self.method)))?;
+        let denoise = Denoise::from_name(&self.denoise)
+            .ok_or_else(|| format!("an unknown denoiser `{}`", crate::echo(&self.denoise)))?;
+        Ok((method, denoise))
+    }
+
     /// The first field in which `self` and `other` differ, with both values.
     fn difference(&self, other: &PartKey) -> Option<String> {
         let (a, b) = (
@@ -508,10 +520,7 @@ impl PartFilm {
                 key.height, rows.start, rows.end, info.rows[0], info.rows[1]
             )));
         }
-        let method = Method::from_name(&key.method)
-            .ok_or_else(|| bad(format!("an unknown method `{}`", crate::echo(&key.method))))?;
-        let denoise = Denoise::from_name(&key.denoise)
-            .ok_or_else(|| bad(format!("an unknown denoiser `{}`", crate::echo(&key.denoise))))?;
+        let (method, denoise) = key.method_and_denoiser().map_err(bad)?;
         let reads = reads_covariance(method, denoise, key.spp, false);
         let layers = if reads { 2 } else { 1 };
         let (w, h) = (key.width as usize, rows.len());
@@ -660,10 +669,7 @@ pub fn merge(parts: &[PartFilm]) -> Result<Merged, RenderError> {
             rows.start, rows.end
         )));
     }
-    let method = Method::from_name(&key.method)
-        .ok_or_else(|| bad(format!("an unknown method `{}`", crate::echo(&key.method))))?;
-    let denoise = Denoise::from_name(&key.denoise)
-        .ok_or_else(|| bad(format!("an unknown denoiser `{}`", crate::echo(&key.denoise))))?;
+    let (method, denoise) = key.method_and_denoiser().map_err(bad)?;
     let wu = w as usize;
     let mut film = Film::new(w, h);
     let mut pixels = vec![PixelCov::default(); wu * h as usize];
