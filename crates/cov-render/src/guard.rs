@@ -22,10 +22,14 @@
 //! ```
 //!
 //! The first line is what makes the check work: a filter that blurs detail the pass did
-//! not see predicts `x_p` badly from the neighbours, whatever Σ said. `σ²` is the sample
-//! variance of the pixel's luminance over its count; it overstates the variance of a
-//! quasi-Monte Carlo mean, which makes the box look worse than it is, so the guard leans
-//! towards filtering where it cannot tell. A pixel with a single sample has no sample
+//! not see predicts `x_p` badly from the neighbours, whatever Σ said. In the box's error
+//! and the noise term, `σ²` is the sample variance of the pixel's luminance over its
+//! count; it overstates the variance of a quasi-Monte Carlo mean, which makes the box
+//! look worse than it is, so the guard leans towards filtering where it cannot tell. The
+//! `σ²` taken off the residual is the estimate that sees the net's convergence
+//! ([`Film::variance_of_mean`]): there an overstated noise would hide the bias of a
+//! filter that blurs a faint texture (a felt directly lit, whose pixel means err 20 times
+//! less at 16 samples than at 4). A pixel with a single sample has no sample
 //! variance; it takes its neighbourhood's noise (the least, over four directions, of the
 //! neighbouring pixels' squared differences; see `one_sample_variance`). The estimates
 //! are relative (divided by the squared 3×3 mean luminance plus
@@ -160,6 +164,8 @@ fn choose(
         })
         .collect();
     let var = one_sample_variance(film);
+    // The variance of the pixel's mean in the box's error and the noise terms: Monte
+    // Carlo's, `s²/n` (an upper bound for a scrambled net's mean).
     let s2: Vec<f64> = (0..n).map(|i| var[i] / f64::from(film.count[i].max(1))).collect();
     // The variance of the pixel's mean at the target count.
     let s2_target: Vec<f64> = (0..n)
@@ -167,6 +173,13 @@ fn choose(
             let c = f64::from(film.count[i].max(1));
             s2[i] * (c / target.max(c))
         })
+        .collect();
+    // The noise that the cross-validation residual carries, taken off it to leave the
+    // filter's bias: the estimate that sees the net's convergence, so that Monte
+    // Carlo's overstated noise does not hide a bias (module docs).
+    let of_mean = film.variance_of_mean();
+    let noise: Vec<f64> = (0..n)
+        .map(|i| if film.count[i] >= 2 { of_mean[i] } else { s2[i] })
         .collect();
     // The normaliser of the relative error: the squared 3×3 mean luminance.
     let norm: Vec<f64> = box3(w, h, &lx, rows).iter().map(|m| m * m + REL_EPS).collect();
@@ -188,7 +201,7 @@ fn choose(
                 }
                 let loo = (sum - luminance(film.reflected[p]) * own) / loo_w;
                 let cv = (loo - lx[p]).powi(2);
-                (alpha * alpha * s2_target[p] + (1.0 - alpha).powi(2) * (cv - s2[p]).max(0.0)) / norm[p]
+                (alpha * alpha * s2_target[p] + (1.0 - alpha).powi(2) * (cv - noise[p]).max(0.0)) / norm[p]
             })
             .collect();
         risks.push(box3(w, h, &risk, rows));

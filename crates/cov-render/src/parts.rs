@@ -62,9 +62,9 @@ use crate::{RenderError, World};
 
 pub use crate::renderer::MAX_PARTS;
 /// Version of the part file's layout and key (3: covariance tracing followed by a
-/// denoiser below 3 spp carries no covariance layer).
-pub const FORMAT: u32 = 3;
-/// Most channels a part file may hold (the film's 32 and the maps' 10 fit).
+/// denoiser below 3 spp carries no covariance layer; 4: the film's `lum.top`).
+pub const FORMAT: u32 = 4;
+/// Most channels a part file may hold (the film's 33 and the maps' 10 fit).
 const MAX_CHANNELS: usize = 64;
 
 /// Part `index` (1-based) of `count`.
@@ -298,6 +298,7 @@ impl PartFilm {
             emitted: crop(&film.emitted, w, &rows),
             reflected: crop(&film.reflected, w, &rows),
             lum: crop(&film.lum, w, &rows),
+            lum_top: crop(&film.lum_top, w, &rows),
             albedo: crop(&film.albedo, w, &rows),
             normal: crop(&film.normal, w, &rows),
             depth: crop(&film.depth, w, &rows),
@@ -325,7 +326,7 @@ impl PartFilm {
 type FilmField = (&'static str, fn(&Film, usize) -> f64, fn(&mut Film, usize, f64));
 
 /// The film's `f64` sums, as channels.
-const FILM_FIELDS: [FilmField; 15] = [
+const FILM_FIELDS: [FilmField; 16] = [
     ("emitted.R", |f, i| f.emitted[i].x, |f, i, v| f.emitted[i].x = v),
     ("emitted.G", |f, i| f.emitted[i].y, |f, i, v| f.emitted[i].y = v),
     ("emitted.B", |f, i| f.emitted[i].z, |f, i, v| f.emitted[i].z = v),
@@ -346,6 +347,7 @@ const FILM_FIELDS: [FilmField; 15] = [
     ),
     ("lum.sum", |f, i| f.lum[i][0], |f, i, v| f.lum[i][0] = v),
     ("lum.sum2", |f, i| f.lum[i][1], |f, i, v| f.lum[i][1] = v),
+    ("lum.top", |f, i| f.lum_top[i], |f, i, v| f.lum_top[i] = v),
     ("albedo.R", |f, i| f.albedo[i].x, |f, i, v| f.albedo[i].x = v),
     ("albedo.G", |f, i| f.albedo[i].y, |f, i, v| f.albedo[i].y = v),
     ("albedo.B", |f, i| f.albedo[i].z, |f, i, v| f.albedo[i].z = v),
@@ -682,6 +684,7 @@ pub fn merge(parts: &[PartFilm]) -> Result<Merged, RenderError> {
         film.emitted[at..at + n].copy_from_slice(&f.emitted);
         film.reflected[at..at + n].copy_from_slice(&f.reflected);
         film.lum[at..at + n].copy_from_slice(&f.lum);
+        film.lum_top[at..at + n].copy_from_slice(&f.lum_top);
         film.albedo[at..at + n].copy_from_slice(&f.albedo);
         film.normal[at..at + n].copy_from_slice(&f.normal);
         film.depth[at..at + n].copy_from_slice(&f.depth);

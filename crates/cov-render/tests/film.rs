@@ -247,3 +247,89 @@ fn the_covariance_filter_lowers_the_error_of_a_noisy_image() {
         eu.relmse
     );
 }
+
+/// `lum_top` holds the luminance of each pixel's last dyadic block of sample indices
+/// (`n/2 .. n` at a power of two `n`), whichever passes the samples came in.
+#[test]
+fn lum_top_is_the_last_dyadic_block() {
+    let world = common::plane_under_sphere_light(60.0, 8, 6);
+    let n = 8 * 6;
+    let render = |passes: &[u32]| {
+        let mut f = Film::new(8, 6);
+        for &c in passes {
+            f.render(&world, &vec![c; n], 3, f64::INFINITY, None);
+        }
+        f
+    };
+    let (four, eight) = (render(&[4]), render(&[8]));
+    // Two passes crossing the blocks 2..4 and 4..8, and three that end inside a block.
+    let (split, ragged) = (render(&[2, 6]), render(&[1, 2, 5]));
+    for i in 0..n {
+        let top = eight.lum[i][0] - four.lum[i][0];
+        let tol = 1e-12 * eight.lum[i][0].abs().max(1e-300);
+        assert!((eight.lum_top[i] - top).abs() <= tol, "pixel {i}");
+        assert!((split.lum_top[i] - top).abs() <= tol, "pixel {i}, passes 2 + 6");
+        assert!(
+            (ragged.lum_top[i] - top).abs() <= tol,
+            "pixel {i}, passes 1 + 2 + 5"
+        );
+        assert_eq!(split.count[i], 8);
+    }
+    // Below two samples the block is the samples themselves.
+    let one = render(&[1]);
+    assert_eq!(one.lum_top, one.lum.iter().map(|l| l[0]).collect::<Vec<_>>());
+}
+
+/// `variance_of_mean` sees the convergence of a pixel's scrambled net: on a directly lit
+/// plane (a smooth integrand) it is well below the Monte Carlo estimate `s²/n` and still
+/// not below the actual error of the pixel means; on independent noise (no net) it is
+/// the Monte Carlo estimate.
+#[test]
+fn variance_of_mean_sees_the_nets_convergence() {
+    let (w, h) = (48u32, 36u32);
+    let n = (w * h) as usize;
+    let world = common::plane_under_sphere_light(60.0, w, h);
+    let mut film = Film::new(w, h);
+    film.render(&world, &vec![16; n], 5, f64::INFINITY, None);
+    let mut reference = Film::new(w, h);
+    reference.render(&world, &vec![1024; n], 6, f64::INFINITY, None);
+    let mean = |v: &[f64]| v.iter().sum::<f64>() / v.len() as f64;
+    let var = film.variance();
+    let mc = mean(&var.iter().map(|v| v / 16.0).collect::<Vec<_>>());
+    let est = mean(&film.variance_of_mean());
+    let actual = mean(
+        &(0..n)
+            .map(|i| (film.lum[i][0] / 16.0 - reference.lum[i][0] / 1024.0).powi(2))
+            .collect::<Vec<_>>(),
+    );
+    // Measured: s²/n 8.6e-8, the pixel means' actual squared error 3.6e-8 (the net
+    // converges faster than Monte Carlo), this estimate 4.4e-8.
+    assert!(actual < 0.5 * mc, "actual {actual:.3e}, Monte Carlo's {mc:.3e}");
+    assert!(est < 0.6 * mc, "estimate {est:.3e}, Monte Carlo's {mc:.3e}");
+    assert!(est > actual, "estimate {est:.3e}, actual {actual:.3e}");
+    // Independent Gaussian noise: the halves are independent, the split agrees with
+    // s²/n in expectation, and the pooled ratio (at most 1) is near 1.
+    use rand::{Rng, SeedableRng};
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(11);
+    let mut noise = Film::new(w, h);
+    for i in 0..n {
+        let mut top = 0.0;
+        for k in 0..16 {
+            let (u, v): (f64, f64) = (rng.random::<f64>().max(1e-300), rng.random());
+            let y = 1.0 + 0.1 * (-2.0 * u.ln()).sqrt() * (std::f64::consts::TAU * v).cos();
+            noise.lum[i][0] += y;
+            noise.lum[i][1] += y * y;
+            if k >= 8 {
+                top += y;
+            }
+        }
+        noise.count[i] = 16;
+        noise.lum_top[i] = top;
+    }
+    let mc = mean(&noise.variance().iter().map(|v| v / 16.0).collect::<Vec<_>>());
+    let est = mean(&noise.variance_of_mean());
+    assert!(
+        est > 0.8 * mc && est <= mc,
+        "estimate {est:.3e}, Monte Carlo's {mc:.3e}"
+    );
+}
