@@ -110,7 +110,7 @@ pub const CUTOFF: f64 = 3.0;
 /// split estimates: 9×9 pixels, 81 degrees of freedom, so that the pooled ratio's
 /// relative standard deviation is about `√(2/81)` = 16% (Gaussian noise); 3×3 pixels
 /// would give 47%.
-pub const SPLIT_REACH: i64 = 4;
+pub const SPLIT_REACH: usize = 4;
 /// Tiles rendered between two merges into the film (bounds the memory of tile results).
 const BATCH: usize = 64;
 
@@ -387,13 +387,30 @@ pub struct Aovs {
 }
 
 /// What one tile hands to the film, per pixel row by row: the sums of emitted and
-/// reflected radiance, the count, the luminance sums, the sums of the features.
-type TileOut = Vec<(DVec3, DVec3, u32, [f64; 2], (DVec3, DVec3, f64), Top)>;
+/// reflected radiance, the count, the luminance sums, the sums of the features, and the
+/// pixel's new [`Film::lum_top`].
+type TileOut = Vec<(DVec3, DVec3, u32, [f64; 2], (DVec3, DVec3, f64), f64)>;
 
-/// A tile's part of a pixel's [`Film::lum_top`]: the luminance of its samples in the
-/// pixel's last dyadic block, and whether that block began in the tile (the film's sum
-/// then restarts from it).
-type Top = (f64, bool);
+/// Running sums of `v` over windows of `2r + 1` along one axis of an image: `n` lines of
+/// `len` values, value `k` of line `l` at `l · line + k · step` (rows: `line = width`,
+/// `step = 1`; columns the other way round). The window is clipped at the ends.
+fn box_sums(v: &[[f64; 2]], len: usize, n: usize, r: usize, step: usize, line: usize) -> Vec<[f64; 2]> {
+    let mut out = vec![[0.0; 2]; v.len()];
+    for l in 0..n {
+        let at = |k: usize| l * line + k * step;
+        // Each window's sum from scratch (2r + 1 terms a value): no running difference,
+        // whose rounding would leave a residue where a window holds only zeros.
+        for k in 0..len {
+            let mut s = [0.0; 2];
+            for q in k.saturating_sub(r)..(k + r + 1).min(len) {
+                s[0] += v[at(q)][0];
+                s[1] += v[at(q)][1];
+            }
+            out[at(k)] = s;
+        }
+    }
+    out
+}
 
 /// Rows of pixels one reconstruction band splats (bands run in parallel).
 const BAND: usize = 16;
@@ -582,40 +599,35 @@ impl Film {
     /// the ratio `Σ split / Σ s²/n` over the pixels within [`SPLIT_REACH`] that have a
     /// split, at most 1 (a scrambled net is not taken to be worse than Monte Carlo).
     pub fn variance_of_mean(&self) -> Vec<f64> {
-        const R: i64 = SPLIT_REACH;
-        let (w, h) = (self.width as i64, self.height as i64);
+        const R: usize = SPLIT_REACH;
+        let (w, h) = (self.width as usize, self.height as usize);
         let var = self.variance();
         let mc: Vec<f64> = (0..self.count.len())
             .map(|i| var[i] / f64::from(self.count[i].max(1)))
             .collect();
         // The split estimate where the count is a power of two of at least 2:
-        // (m₁ − m₂)²/4 = ((S − T) − T)² / n², `S` the sum and `T` the second half's.
-        let split: Vec<Option<f64>> = (0..self.count.len())
+        // (m₁ − m₂)²/4 = ((S − T) − T)² / n², `S` the sum and `T` the second half's; and
+        // the Monte Carlo estimate of the same pixels.
+        let pairs: Vec<[f64; 2]> = (0..self.count.len())
             .map(|i| {
                 let n = self.count[i];
-                (n >= 2 && n.is_power_of_two()).then(|| {
+                if n >= 2 && n.is_power_of_two() {
                     let d = (self.lum[i][0] - 2.0 * self.lum_top[i]) / f64::from(n);
-                    d * d
-                })
+                    [d * d, mc[i]]
+                } else {
+                    [0.0; 2]
+                }
             })
             .collect();
-        (0..w * h)
-            .into_par_iter()
+        // Their sums over the (2R + 1)² pixels around, a row pass then a column pass.
+        let rows = box_sums(&pairs, w, h, R, 1, w);
+        let sums = box_sums(&rows, h, w, R, w, 1);
+        (0..self.count.len())
             .map(|i| {
-                let (x, y) = (i % w, i / w);
-                let (mut a, mut b) = (0.0, 0.0);
-                for yy in (y - R).max(0)..=(y + R).min(h - 1) {
-                    for xx in (x - R).max(0)..=(x + R).min(w - 1) {
-                        let j = (yy * w + xx) as usize;
-                        if let Some(v) = split[j] {
-                            a += v;
-                            b += mc[j];
-                        }
-                    }
-                }
+                let [a, b] = sums[i];
                 // No split around, or no variance to scale: Monte Carlo's estimate.
                 let gain = if b > 0.0 { (a / b).min(1.0) } else { 1.0 };
-                mc[i as usize] * gain
+                mc[i] * gain
             })
             .collect()
     }
@@ -661,11 +673,8 @@ impl Film {
                 .collect();
             for (&(x0, y0, x1, y1), out) in batch.iter().zip(outs) {
                 let coords = (y0..y1).flat_map(|y| (x0..x1).map(move |x| (y * w + x) as usize));
-                for (i, (e, r, n, l, aov, (top, restart))) in coords.zip(out) {
-                    if restart {
-                        self.lum_top[i] = 0.0;
-                    }
-                    self.lum_top[i] += top;
+                for (i, (e, r, n, l, aov, top)) in coords.zip(out) {
+                    self.lum_top[i] = top;
                     self.albedo[i] += aov.0;
                     self.normal[i] += aov.1;
                     self.depth[i] += aov.2;
@@ -698,11 +707,11 @@ impl Film {
                 let mut sampler = SobolSampler::new(seed, w, x, y);
                 let (mut se, mut sr, mut l1, mut l2) = (DVec3::ZERO, DVec3::ZERO, 0.0, 0.0);
                 let mut aov = (DVec3::ZERO, DVec3::ZERO, 0.0);
-                let mut top = (0.0, false);
+                let mut top = self.lum_top[i];
                 for s in first..first + n {
                     // Sample `s` opens the dyadic block `s .. 2s` (and sample 0 its own).
                     if s == 0 || s.is_power_of_two() {
-                        top = (0.0, true);
+                        top = 0.0;
                     }
                     sampler.start(s);
                     let s = &mut sampler;
@@ -733,7 +742,7 @@ impl Film {
                     sr += r;
                     l1 += yl;
                     l2 += yl * yl;
-                    top.0 += yl;
+                    top += yl;
                 }
                 out.push((se, sr, n, [l1, l2], aov, top));
             }

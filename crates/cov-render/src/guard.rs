@@ -77,10 +77,20 @@ pub fn candidates(guide: &Guide, rows: Range<u32>) -> Vec<Vec<Gaussian>> {
 /// The per-pixel filters of candidate `scale`: `scale · F₀`, kept off the pass's edges
 /// in `rows`.
 pub fn candidate(guide: &Guide, scale: f64, rows: Range<u32>) -> Vec<Gaussian> {
+    // A block of the covariance grid shares one matched filter: a pixel equal to its left
+    // neighbour reuses its Gaussian.
+    let mut last: Option<([f64; 3], Gaussian)> = None;
     let raw: Vec<Gaussian> = guide
         .matched
         .iter()
-        .map(|f| Gaussian::from_cov(f.map(|v| v * scale)))
+        .map(|f| match last {
+            Some((q, g)) if q == *f => g,
+            _ => {
+                let g = Gaussian::from_cov(f.map(|v| v * scale));
+                last = Some((*f, g));
+                g
+            }
+        })
         .collect();
     edge_clamp(guide.width, guide.height, &raw, rows)
 }
