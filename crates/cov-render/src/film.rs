@@ -391,7 +391,7 @@ pub struct Aovs {
 /// pixel's new [`Film::lum_top`].
 type TileOut = Vec<(DVec3, DVec3, u32, [f64; 2], (DVec3, DVec3, f64), f64)>;
 
-/// Running sums of `v` over windows of `2r + 1` along one axis of an image: `n` lines of
+/// Sums of `v` over windows of `2r + 1` values along one axis of an image: `n` lines of
 /// `len` values, value `k` of line `l` at `l · line + k · step` (rows: `line = width`,
 /// `step = 1`; columns the other way round). The window is clipped at the ends.
 fn box_sums(v: &[[f64; 2]], len: usize, n: usize, r: usize, step: usize, line: usize) -> Vec<[f64; 2]> {
