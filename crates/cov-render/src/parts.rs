@@ -64,7 +64,8 @@ pub use crate::renderer::MAX_PARTS;
 /// Version of the part file's layout and key (3: covariance tracing followed by a
 /// denoiser below 3 spp carries no covariance layer; 4: the film's `lum.top`).
 pub const FORMAT: u32 = 4;
-/// Most channels a part file may hold (the film's 33 and the maps' 10 fit).
+/// Most channels a layer of a part file may hold (the film's holds 36: a count, a
+/// preview's R, G, B and two per sum; the maps' 10).
 const MAX_CHANNELS: usize = 64;
 
 /// Part `index` (1-based) of `count`.
