@@ -123,6 +123,8 @@ pub struct Gaussian {
     norm: f64,
     /// Larger std (px).
     std_max: f64,
+    /// Rows the [`CUTOFF`] ellipse reaches above and below its centre.
+    reach_rows: usize,
     /// `exp(−precision_xx)`: the recurrence factor of [`Gaussian::row_weights`].
     decay: f64,
 }
@@ -161,6 +163,9 @@ impl Gaussian {
             precision: [pxx, vx * vy * (i1 - i2), vy * vy * i1 + vx * vx * i2],
             norm: 1.0 / (2.0 * std::f64::consts::PI * (l1 * l2).sqrt()),
             std_max: l1.max(l2).sqrt(),
+            // The ellipse's half-height is CUTOFF · σ_y, with σ_y² = C_yy = pxx / det P;
+            // one part in 10¹² more, so that rounding never drops a row on the ellipse.
+            reach_rows: (CUTOFF * (pxx * l1 * l2).max(0.0).sqrt() * (1.0 + 1e-12)).ceil() as usize,
             decay: (-pxx).exp(),
         }
     }
@@ -185,6 +190,14 @@ impl Gaussian {
     /// `⌈CUTOFF · std_max⌉`.
     pub fn reach(&self) -> usize {
         (CUTOFF * self.std_max).ceil() as usize
+    }
+
+    /// How many rows the filter reaches above and below its centre: `⌈CUTOFF · σ_y⌉`, the
+    /// half-height of the [`CUTOFF`] ellipse. At most [`Gaussian::reach`], and much less
+    /// for a filter drawn out along the rows (as motion blur draws them): the rows a
+    /// splat visits.
+    pub fn reach_rows(&self) -> usize {
+        self.reach_rows
     }
 
     /// The covariance `[xx, xy, yy]` (px²).
@@ -305,8 +318,8 @@ impl Filter {
 struct Stencil {
     /// The filter the weights are of.
     of: Option<Gaussian>,
-    /// Per row `dy = −reach ..= reach` ([`Gaussian::reach`]): the first column offset and
-    /// the row's range in `weights`.
+    /// Per row `dy = −reach ..= reach` ([`Gaussian::reach_rows`]): the first column
+    /// offset and the row's range in `weights`.
     rows: Vec<(i64, Range<usize>)>,
     /// The weights, row after row.
     weights: Vec<f64>,
@@ -320,13 +333,13 @@ impl Stencil {
         }
         self.rows.clear();
         self.weights.clear();
-        let ri = g.reach() as i64;
+        let (ri, rx) = (g.reach_rows() as i64, g.reach() as i64);
         // Rows 0 ..= ri from the Gaussian; row −dy is row dy reversed (w(−x, −dy) =
         // w(x, dy), and the exponent is the same to the bit, so are its cells).
         self.rows.resize(2 * ri as usize + 1, (0, 0..0));
         for dy in 0..=ri {
             let k = self.weights.len();
-            let first = g.row_weights(dy as f64, -ri, ri, &mut self.weights);
+            let first = g.row_weights(dy as f64, -rx, rx, &mut self.weights);
             let n = self.weights.len() - k;
             self.rows[(ri + dy) as usize] = (first, k..k + n);
             if dy > 0 {
@@ -339,7 +352,7 @@ impl Stencil {
         self.of = Some(*g);
     }
 
-    /// The reach of the filter the stencil is of.
+    /// The reach in rows of the filter the stencil is of.
     fn reach(&self) -> usize {
         self.rows.len() / 2
     }
@@ -519,7 +532,7 @@ impl Film {
                 let (y0, y1) = (b * BAND, ((b + 1) * BAND).min(h));
                 let reach = (y0 * w..y1 * w)
                     .filter_map(|i| filter.at(i))
-                    .map(Gaussian::reach)
+                    .map(Gaussian::reach_rows)
                     .max()
                     .unwrap_or(0);
                 let top = y0.saturating_sub(reach);
@@ -856,6 +869,13 @@ mod tests {
                         );
                     }
                     assert!(out.len() <= (hi - lo + 2).max(1) as usize && out[0] == 7.0);
+                }
+                // No cell lies beyond the rows the filter says it reaches.
+                let beyond = g.reach_rows() as f64 + 1.0;
+                for dy in [beyond, -beyond] {
+                    let mut out = Vec::new();
+                    g.row_weights(dy, -r, r, &mut out);
+                    assert!(out.is_empty(), "{c:?}: row {dy} has {} cells", out.len());
                 }
             }
         }
