@@ -137,11 +137,15 @@ const CLAMP_TILE: i64 = 4;
 /// filter stops short of an edge the covariance pass saw a few pixels away. Each std
 /// becomes `min(s_p, min_q max(s_q, d(p, q) / EDGE_REACH))` over every pixel `q`.
 ///
-/// The minimum is taken over tiles of 4×4 pixels first: a tile whose smallest
-/// std and nearest pixel cannot lower the limit is skipped, and a tile of one std
-/// contributes `max(s, d_nearest / EDGE_REACH)` without visiting its pixels. Both give
-/// the per-pixel minimum bit for bit (`max` and `min` are exact, and the distances are
-/// the same square roots of integers).
+/// The minimum is taken over tiles of 4×4 pixels first. Each tile lists, nearest first,
+/// the tiles that could lower the limit of one of its pixels (their smallest std below
+/// its largest, within `EDGE_REACH` times that); a pixel walks its tile's list until the
+/// next tile is too far to matter, skips a tile whose smallest std and nearest pixel
+/// cannot lower its limit, and takes a tile of one std as `max(s, d_nearest /
+/// EDGE_REACH)` without visiting its pixels. All of it gives the per-pixel minimum bit
+/// for bit (`max` and `min` are exact, and the distances are the same square roots of
+/// integers): the unit test `edge_clamp_is_its_definition` checks it against the
+/// definition.
 ///
 /// Only the pixels of `rows` are narrowed (a part of a render, the `parts` module); the
 /// others keep their raw filter.
@@ -166,37 +170,71 @@ pub fn edge_clamp(width: u32, height: u32, raw: &[Gaussian], rows: Range<u32>) -
         })
         .collect();
     let (r0, r1) = (i64::from(rows.start) * w, i64::from(rows.end.min(height)) * w);
+    // Per tile, the tiles that may lower the limit of one of its pixels, nearest first
+    // (with the square of the gap between the two): a tile whose least std is at least
+    // the widest here, or farther than EDGE_REACH times it, cannot (the pixel's own std
+    // is the limit it starts from). The pixels of a tile share the list.
+    let lists: Vec<Vec<(i64, usize)>> = (0..tw * th)
+        .into_par_iter()
+        .map(|k| {
+            let (_, hi) = tiles[k as usize];
+            let ((x0, x1), (y0, y1)) = (span(k % tw, w), span(k / tw, h));
+            let r = (EDGE_REACH * hi).ceil() as i64;
+            if r < 1 || y1 * w + x1 < r0 || y0 * w + x0 >= r1 {
+                return Vec::new();
+            }
+            // Beyond this squared gap (px²) a tile is farther than EDGE_REACH · hi, with a
+            // margin of one part in 10⁹ over the rounding of the comparison.
+            let far = (EDGE_REACH * hi).powi(2) * (1.0 + 1e-9);
+            let mut list = Vec::new();
+            for ty in (y0 - r).max(0) / t..=(y1 + r).min(h - 1) / t {
+                for tx in (x0 - r).max(0) / t..=(x1 + r).min(w - 1) / t {
+                    let u = ty * tw + tx;
+                    let ((u0, u1), (v0, v1)) = (span(tx, w), span(ty, h));
+                    let (gx, gy) = ((u0 - x1).max(x0 - u1).max(0), (v0 - y1).max(y0 - v1).max(0));
+                    let gap = gx * gx + gy * gy;
+                    if tiles[u as usize].0 < hi && (gap as f64) <= far {
+                        list.push((gap, u as usize));
+                    }
+                }
+            }
+            list.sort_unstable();
+            list
+        })
+        .collect();
     (0..w * h)
         .into_par_iter()
         .map(|i| {
             let g = raw[i as usize];
             let s = stds[i as usize];
-            // Pixels farther than EDGE_REACH · s cannot lower the limit below s.
-            let r = (EDGE_REACH * s).ceil() as i64;
-            if i < r0 || i >= r1 || r < 1 {
+            if i < r0 || i >= r1 {
                 return g;
             }
             let (x, y) = (i % w, i / w);
             let dist = |dx: i64, dy: i64| ((dx * dx + dy * dy) as f64).sqrt();
             let mut limit = s;
-            for ty in (y - r).max(0) / t..=(y + r).min(h - 1) / t {
-                for tx in (x - r).max(0) / t..=(x + r).min(w - 1) / t {
-                    let ((x0, x1), (y0, y1)) = (span(tx, w), span(ty, h));
-                    let (lo, hi) = tiles[(ty * tw + tx) as usize];
-                    let near = dist((x0 - x).max(x - x1).max(0), (y0 - y).max(y - y1).max(0));
-                    let bound = lo.max(near / EDGE_REACH);
-                    if bound >= limit {
-                        continue;
-                    }
-                    if lo == hi {
-                        limit = bound;
-                        continue;
-                    }
-                    for yy in y0..=y1 {
-                        for xx in x0..=x1 {
-                            let sq = stds[(yy * w + xx) as usize];
-                            limit = limit.min(sq.max(dist(xx - x, yy - y) / EDGE_REACH));
-                        }
+            for &(gap, u) in &lists[((y / t) * tw + x / t) as usize] {
+                // The pixel is at least the gap away from every cell of `u`, and the
+                // tiles come nearest first: none after this one can lower the limit.
+                if (gap as f64).sqrt() / EDGE_REACH >= limit {
+                    break;
+                }
+                let (tx, ty) = (u as i64 % tw, u as i64 / tw);
+                let ((x0, x1), (y0, y1)) = (span(tx, w), span(ty, h));
+                let (lo, hi) = tiles[u];
+                let near = dist((x0 - x).max(x - x1).max(0), (y0 - y).max(y - y1).max(0));
+                let bound = lo.max(near / EDGE_REACH);
+                if bound >= limit {
+                    continue;
+                }
+                if lo == hi {
+                    limit = bound;
+                    continue;
+                }
+                for yy in y0..=y1 {
+                    for xx in x0..=x1 {
+                        let sq = stds[(yy * w + xx) as usize];
+                        limit = limit.min(sq.max(dist(xx - x, yy - y) / EDGE_REACH));
                     }
                 }
             }
