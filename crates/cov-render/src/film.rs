@@ -312,49 +312,84 @@ impl Filter {
     }
 }
 
-/// A filter's weights over its whole support, row by row, so that neighbouring pixels
-/// with the same filter (a block of the covariance grid shares one) compute them once.
-#[derive(Default)]
-struct Stencil {
-    /// The filter the weights are of.
-    of: Option<Gaussian>,
-    /// Per row `dy = −reach ..= reach` ([`Gaussian::reach_rows`]): the first column
-    /// offset and the row's range in `weights`.
+/// Slots of a band's [`Stencils`] (a power of two).
+const STENCIL_SLOTS: usize = 1 << 10;
+/// Most weights a band's [`Stencils`] keep (8 MB): past it they start afresh.
+const STENCIL_WEIGHTS: usize = 1 << 20;
+
+/// The weights of the filters a band splats, each over its whole support, row by row,
+/// so that pixels with the same filter compute them once: the pixels of a block of the
+/// covariance grid share one, and pixels near an edge take filters narrowed by their
+/// distance to it, which repeat along the edge a row apart, where one stencil would be
+/// lost to the pixels in between. A filter's stencil is kept in a slot found from its
+/// precision's bits (a later filter of the same slot takes it over).
+struct Stencils {
+    /// Per slot: the filter and the range of its rows in `rows`.
+    slots: Vec<Option<(Gaussian, Range<usize>)>>,
+    /// Per row of each stencil (`dy = −reach ..= reach`, [`Gaussian::reach_rows`]): the
+    /// first column offset and the row's range in `weights`.
     rows: Vec<(i64, Range<usize>)>,
     /// The weights, row after row.
     weights: Vec<f64>,
+    /// The slot used last.
+    last: usize,
 }
 
-impl Stencil {
-    /// Makes this the stencil of `g` (nothing to do if it already is).
-    fn set(&mut self, g: &Gaussian) {
-        if self.of.as_ref() == Some(g) {
-            return;
+impl Stencils {
+    /// No stencil yet.
+    fn new() -> Stencils {
+        Stencils {
+            slots: vec![None; STENCIL_SLOTS],
+            rows: Vec::new(),
+            weights: Vec::new(),
+            last: 0,
         }
-        self.rows.clear();
-        self.weights.clear();
+    }
+
+    /// The range in [`Stencils::rows`] of `g`'s stencil (made if it is not kept).
+    fn of(&mut self, g: &Gaussian) -> Range<usize> {
+        if !matches!(&self.slots[self.last], Some((f, _)) if f == g) {
+            // A multiplicative hash of the precision's bits picks the slot.
+            let [a, b, c] = g.precision.map(f64::to_bits);
+            let mix = (a ^ b.rotate_left(21) ^ c.rotate_left(42)).wrapping_mul(0x9E37_79B9_7F4A_7C15);
+            self.last = (mix >> (64 - STENCIL_SLOTS.trailing_zeros())) as usize;
+            if !matches!(&self.slots[self.last], Some((f, _)) if f == g) {
+                if self.weights.len() > STENCIL_WEIGHTS {
+                    self.slots.iter_mut().for_each(|s| *s = None);
+                    self.rows.clear();
+                    self.weights.clear();
+                }
+                let rows = self.make(g);
+                self.slots[self.last] = Some((*g, rows));
+            }
+        }
+        match &self.slots[self.last] {
+            Some((_, rows)) => rows.clone(),
+            None => 0..0,
+        }
+    }
+
+    /// Appends `g`'s stencil; returns the range of its rows.
+    fn make(&mut self, g: &Gaussian) -> Range<usize> {
         let (ri, rx) = (g.reach_rows() as i64, g.reach() as i64);
+        let start = self.rows.len();
         // Rows 0 ..= ri from the Gaussian; row −dy is row dy reversed (w(−x, −dy) =
         // w(x, dy), and the exponent is the same to the bit, so are its cells).
-        self.rows.resize(2 * ri as usize + 1, (0, 0..0));
+        self.rows.resize(start + 2 * ri as usize + 1, (0, 0..0));
+        let rows = &mut self.rows[start..];
         for dy in 0..=ri {
             let k = self.weights.len();
             let first = g.row_weights(dy as f64, -rx, rx, &mut self.weights);
             let n = self.weights.len() - k;
-            self.rows[(ri + dy) as usize] = (first, k..k + n);
+            rows[(ri + dy) as usize] = (first, k..k + n);
             if dy > 0 {
                 self.weights.extend_from_within(k..k + n);
                 self.weights[k + n..].reverse();
                 // The reversed run ends at −first.
-                self.rows[(ri - dy) as usize] = (1 - first - n as i64, k + n..k + 2 * n);
+                rows[(ri - dy) as usize] = (1 - first - n as i64, k + n..k + 2 * n);
             }
         }
-        self.of = Some(*g);
-    }
-
-    /// The reach in rows of the filter the stencil is of.
-    fn reach(&self) -> usize {
-        self.rows.len() / 2
+        start..self.rows.len()
     }
 }
 
@@ -538,7 +573,7 @@ impl Film {
                 let top = y0.saturating_sub(reach);
                 let bottom = (y1 + reach).min(h);
                 let mut buf = vec![[0.0f64; K]; (bottom - top) * w];
-                let mut st = Stencil::default();
+                let mut stencils = Stencils::new();
                 for y in y0..y1 {
                     for x in 0..w {
                         let i = y * w + x;
@@ -547,14 +582,15 @@ impl Film {
                             continue;
                         }
                         let v = values(i);
-                        st.set(g);
-                        let r = st.reach();
+                        let at = stencils.of(g);
+                        let (rows, weights) = (&stencils.rows[at], &stencils.weights);
+                        let r = rows.len() / 2;
                         for py in y.saturating_sub(r)..(y + r + 1).min(h) {
-                            let (first, ref k) = st.rows[py + r - y];
+                            let (first, ref k) = rows[py + r - y];
                             // The row's run, clipped to the image's columns.
                             let c0 = (x as i64 + first).max(0) as usize;
                             let skip = c0 as i64 - (x as i64 + first);
-                            let wts = &st.weights[(k.start + skip as usize).min(k.end)..k.end];
+                            let wts = &weights[(k.start + skip as usize).min(k.end)..k.end];
                             let row = &mut buf[(py - top) * w..(py - top + 1) * w];
                             for (e, &wgt) in row[c0.min(w)..].iter_mut().zip(wts) {
                                 for j in 0..K {
