@@ -146,7 +146,11 @@ impl Gaussian {
         // Unit eigenvector of l1.
         let (vx, vy) = if b.abs() > 1e-300 {
             let (x, y) = (l1 - d, b);
-            let n = x.hypot(y);
+            // `hypot` guards an overflow that finite covariances below 1e150 cannot reach.
+            let n = match (x * x + y * y).sqrt() {
+                n if n.is_finite() && n > 0.0 => n,
+                _ => x.hypot(y),
+            };
             (x / n, y / n)
         } else if a >= d {
             (1.0, 0.0)
