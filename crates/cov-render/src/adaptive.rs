@@ -61,20 +61,7 @@ pub fn allocate_floors(weights: &[f64], total: f64, floors: &[u32], hi: u32, pow
     let (scale, flat) = if wsum <= 0.0 {
         (0.0, (total - least) / n.max(1) as f64)
     } else {
-        // The scale s with Σ clamp(s·wᵢ) = total, by bisection on a log scale.
-        let (mut a, mut b) = (1e-300f64, 1e300f64);
-        for _ in 0..200 {
-            let m = (a * b).sqrt();
-            if sum(m) < total {
-                a = m;
-            } else {
-                b = m;
-            }
-            if b / a < 1.0 + 1e-12 {
-                break;
-            }
-        }
-        (b, 0.0)
+        (scale_for(sum, total, wsum), 0.0)
     };
     let mut carry = 0.0;
     for (i, &v) in w.iter().enumerate() {
@@ -97,6 +84,68 @@ pub fn allocate_floors(weights: &[f64], total: f64, floors: &[u32], hi: u32, pow
         counts.push(c as u32);
     }
     counts
+}
+
+/// The scale `s` at which `sum(s) = Σ clamp(s·wᵢ, loᵢ, hi)`, continuous, nondecreasing
+/// and piecewise linear, reaches `total` (from above: `sum(s) ≥ total`), given
+/// `wsum = Σ wᵢ > 0` and `sum(0) ≤ total ≤ sum(∞)`.
+///
+/// The root is bracketed from `total / wsum` by steps of 16, then found by the Illinois
+/// variant of false position, which a piecewise linear function lets converge in a few
+/// steps (bisection took about 50 sums of every pixel). It stops when the sum is within
+/// 10⁻⁹ of `total` (a hundred-thousandth of a sample on a million pixels' budget) or the
+/// bracket within 10⁻¹² of its size.
+fn scale_for(sum: impl Fn(f64) -> f64, total: f64, wsum: f64) -> f64 {
+    const LOW: f64 = 1e-300;
+    const HIGH: f64 = 1e300;
+    let f = |s: f64| sum(s) - total;
+    let s0 = (total / wsum).clamp(LOW, HIGH);
+    let (mut a, mut b) = (s0, s0);
+    let (mut fa, mut fb) = (f(a), f(b));
+    // The bracket: f(a) < 0 ≤ f(b).
+    while fa >= 0.0 {
+        if a <= LOW {
+            return a;
+        }
+        (b, fb) = (a, fa);
+        a = (a / 16.0).max(LOW);
+        fa = f(a);
+    }
+    while fb < 0.0 && b < HIGH {
+        (a, fa) = (b, fb);
+        b = (b * 16.0).min(HIGH);
+        fb = f(b);
+    }
+    let tol = 1e-9 * total.abs().max(1.0);
+    // `fa` and `fb` are the ends' values, one of them halved by the Illinois step; `at_b`
+    // is f(b) itself.
+    let (mut side, mut at_b) = (0, fb);
+    for _ in 0..200 {
+        if at_b <= tol || b - a <= 1e-12 * b {
+            break;
+        }
+        // False position, kept strictly inside the bracket.
+        let mut s = b - fb * (b - a) / (fb - fa);
+        if !(s > a && s < b) {
+            s = 0.5 * (a + b);
+        }
+        let fs = f(s);
+        if fs >= 0.0 {
+            (b, fb, at_b) = (s, fs, fs);
+            // The same end twice: halve the other's value (Illinois), so that it moves.
+            if side == 1 {
+                fa *= 0.5;
+            }
+            side = 1;
+        } else {
+            (a, fa) = (s, fs);
+            if side == -1 {
+                fb *= 0.5;
+            }
+            side = -1;
+        }
+    }
+    b
 }
 
 /// How many pixels' noise a normalised Gaussian filter of covariance `f` `[xx, xy, yy]`
@@ -469,5 +518,52 @@ mod tests {
         assert!(c[0] >= 16);
         let sum: u32 = c.iter().sum();
         assert!(sum.abs_diff(1024) <= 64, "{sum}");
+    }
+
+    /// The water level is the root of Σ clamp(s·wᵢ, loᵢ, hi) = total, reached from above,
+    /// against bisection, on weights spread over twelve decades with zeros among them,
+    /// random floors, and totals from the floors' sum to every pixel at `hi`.
+    #[test]
+    fn the_scale_is_the_root() {
+        use rand::{Rng, SeedableRng};
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(5);
+        for case in 0..40 {
+            let n = 1 + case * 37;
+            let w: Vec<f64> = (0..n)
+                .map(|_| {
+                    if rng.random::<f64>() < 0.1 {
+                        0.0
+                    } else {
+                        10f64.powf(12.0 * rng.random::<f64>() - 6.0)
+                    }
+                })
+                .collect();
+            let lo: Vec<f64> = (0..n).map(|_| f64::from(rng.random_range(0..8u32))).collect();
+            let hi = 64.0;
+            let sum = |s: f64| -> f64 { w.iter().zip(&lo).map(|(&v, &l)| (v * s).clamp(l, hi)).sum() };
+            let wsum: f64 = w.iter().sum();
+            // Pixels of weight 0 stay at their floor: the most is the sum at an infinite scale.
+            let (least, most) = (lo.iter().sum::<f64>(), sum(1e300));
+            for t in [0.0, 1e-6, 0.3, 0.5, 0.9, 1.0] {
+                let total = least + t * (most - least);
+                let s = scale_for(sum, total, wsum);
+                let got = sum(s);
+                assert!(
+                    got >= total - 1e-9 * total.max(1.0),
+                    "case {case}, t {t}: {got} < {total}"
+                );
+                // Bisection's answer, from above.
+                let (mut a, mut b) = (1e-300f64, 1e300f64);
+                for _ in 0..400 {
+                    let m = (a * b).sqrt();
+                    if sum(m) < total { a = m } else { b = m }
+                }
+                assert!(
+                    (got - sum(b)).abs() <= 1e-8 * total.max(1.0),
+                    "case {case}, t {t}: {got} vs {}",
+                    sum(b)
+                );
+            }
+        }
     }
 }
