@@ -447,18 +447,29 @@ type TileOut = Vec<(DVec3, DVec3, u32, [f64; 2], (DVec3, DVec3, f64), f64)>;
 /// `len` values, value `k` of line `l` at `l · line + k · step` (rows: `line = width`,
 /// `step = 1`; columns the other way round). The window is clipped at the ends.
 fn box_sums(v: &[[f64; 2]], len: usize, n: usize, r: usize, step: usize, line: usize) -> Vec<[f64; 2]> {
+    // Each line's sums (lines in parallel), then put in place.
+    let lines: Vec<Vec<[f64; 2]>> = (0..n)
+        .into_par_iter()
+        .map(|l| {
+            let at = |k: usize| l * line + k * step;
+            // Each window's sum from scratch (2r + 1 terms a value): no running difference,
+            // whose rounding would leave a residue where a window holds only zeros.
+            (0..len)
+                .map(|k| {
+                    let mut s = [0.0; 2];
+                    for q in k.saturating_sub(r)..(k + r + 1).min(len) {
+                        s[0] += v[at(q)][0];
+                        s[1] += v[at(q)][1];
+                    }
+                    s
+                })
+                .collect()
+        })
+        .collect();
     let mut out = vec![[0.0; 2]; v.len()];
-    for l in 0..n {
-        let at = |k: usize| l * line + k * step;
-        // Each window's sum from scratch (2r + 1 terms a value): no running difference,
-        // whose rounding would leave a residue where a window holds only zeros.
-        for k in 0..len {
-            let mut s = [0.0; 2];
-            for q in k.saturating_sub(r)..(k + r + 1).min(len) {
-                s[0] += v[at(q)][0];
-                s[1] += v[at(q)][1];
-            }
-            out[at(k)] = s;
+    for (l, sums) in lines.into_iter().enumerate() {
+        for (k, s) in sums.into_iter().enumerate() {
+            out[l * line + k * step] = s;
         }
     }
     out
@@ -623,7 +634,7 @@ impl Film {
     /// than two).
     pub fn variance(&self) -> Vec<f64> {
         self.lum
-            .iter()
+            .par_iter()
             .zip(&self.count)
             .map(|(&[s, s2], &n)| {
                 if n < 2 {

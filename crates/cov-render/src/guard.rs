@@ -69,7 +69,7 @@ pub struct Guarded {
 /// Only the pixels of `rows` are kept off the edges ([`edge_clamp`]).
 pub fn candidates(guide: &Guide, rows: Range<u32>) -> Vec<Vec<Gaussian>> {
     SCALES
-        .iter()
+        .par_iter()
         .map(|&s| candidate(guide, s, rows.clone()))
         .collect()
 }
@@ -106,10 +106,11 @@ pub fn guarded(candidates: &[Vec<Gaussian>], film: &Film, rows: Range<u32>) -> G
         .collect();
     let lum: Vec<Vec<[f64; 2]>> = sums
         .iter()
-        .map(|acc| acc.iter().map(|&(s, n)| [luminance(s), n]).collect())
+        .map(|acc| acc.par_iter().map(|&(s, n)| [luminance(s), n]).collect())
         .collect();
     let choice = choose(&lum, candidates, film, 0.0, &rows);
     let reflected = (0..film.count.len())
+        .into_par_iter()
         .map(|p| match sums.get(choice[p] as usize) {
             Some(acc) if acc[p].1 > 0.0 => acc[p].0 / acc[p].1,
             _ => match film.count[p] {
@@ -168,6 +169,7 @@ fn choose(
     let inside = |p: usize| rows.contains(&((p as i64 / w.max(1)) as u32));
     let n = film.count.len();
     let lx: Vec<f64> = (0..n)
+        .into_par_iter()
         .map(|i| match film.count[i] {
             0 => 0.0,
             c => luminance(film.reflected[i] / f64::from(c)),
@@ -176,9 +178,13 @@ fn choose(
     let var = one_sample_variance(film);
     // The variance of the pixel's mean in the box's error and the noise terms: Monte
     // Carlo's, `s²/n` (an upper bound for a scrambled net's mean).
-    let s2: Vec<f64> = (0..n).map(|i| var[i] / f64::from(film.count[i].max(1))).collect();
+    let s2: Vec<f64> = (0..n)
+        .into_par_iter()
+        .map(|i| var[i] / f64::from(film.count[i].max(1)))
+        .collect();
     // The variance of the pixel's mean at the target count.
     let s2_target: Vec<f64> = (0..n)
+        .into_par_iter()
         .map(|i| {
             let c = f64::from(film.count[i].max(1));
             s2[i] * (c / target.max(c))
@@ -189,10 +195,14 @@ fn choose(
     // Carlo's overstated noise does not hide a bias (module docs).
     let of_mean = film.variance_of_mean();
     let noise: Vec<f64> = (0..n)
+        .into_par_iter()
         .map(|i| if film.count[i] >= 2 { of_mean[i] } else { s2[i] })
         .collect();
     // The normaliser of the relative error: the squared 3×3 mean luminance.
-    let norm: Vec<f64> = box3(w, h, &lx, rows).iter().map(|m| m * m + REL_EPS).collect();
+    let norm: Vec<f64> = box3(w, h, &lx, rows)
+        .par_iter()
+        .map(|m| m * m + REL_EPS)
+        .collect();
     let mut risks: Vec<Vec<f64>> = Vec::with_capacity(candidates.len() + 1);
     for (filters, acc) in candidates.iter().zip(lum) {
         let risk: Vec<f64> = (0..n)
@@ -219,10 +229,14 @@ fn choose(
     risks.push(box3(
         w,
         h,
-        &(0..n).map(|p| s2_target[p] / norm[p]).collect::<Vec<_>>(),
+        &(0..n)
+            .into_par_iter()
+            .map(|p| s2_target[p] / norm[p])
+            .collect::<Vec<_>>(),
         rows,
     ));
     (0..n)
+        .into_par_iter()
         .map(|p| {
             let mut best = candidates.len();
             for k in (0..candidates.len()).filter(|_| inside(p)) {
