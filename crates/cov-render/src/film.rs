@@ -557,13 +557,26 @@ impl Film {
     /// sample count (the two sums whose ratio [`Film::image`] takes); zero for
     /// [`Filter::Box`] pixels, which splat nothing.
     pub fn splat(&self, filter: &Filter) -> Vec<(DVec3, f64)> {
-        self.splat_values(filter, |i| {
-            let s = self.reflected[i];
-            [s.x, s.y, s.z, f64::from(self.count[i])]
-        })
-        .into_iter()
-        .map(|v| (DVec3::new(v[0], v[1], v[2]), v[3]))
-        .collect()
+        Film::colour(self.splat_by(|i| filter.at(i), |i| self.reflected_and_count(i)))
+    }
+
+    /// [`Film::splat`] with pixel `i`'s filter `filters[i]` (a candidate of the guard,
+    /// splatted without a copy into a [`Filter::PerPixel`]).
+    pub fn splat_each(&self, filters: &[Gaussian]) -> Vec<(DVec3, f64)> {
+        Film::colour(self.splat_by(|i| filters.get(i), |i| self.reflected_and_count(i)))
+    }
+
+    /// Pixel `i`'s reflected sum and count, as [`Film::splat`] splats them.
+    fn reflected_and_count(&self, i: usize) -> [f64; 4] {
+        let s = self.reflected[i];
+        [s.x, s.y, s.z, f64::from(self.count[i])]
+    }
+
+    /// Splatted [`Film::reflected_and_count`] as radiance and count.
+    fn colour(sums: Vec<[f64; 4]>) -> Vec<(DVec3, f64)> {
+        sums.into_iter()
+            .map(|v| (DVec3::new(v[0], v[1], v[2]), v[3]))
+            .collect()
     }
 
     /// Per pixel, the sums of `values` of the pixels with samples, each splatted with its
@@ -574,6 +587,25 @@ impl Film {
         filter: &Filter,
         values: impl Fn(usize) -> [f64; K] + Sync,
     ) -> Vec<[f64; K]> {
+        self.splat_by(|i| filter.at(i), values)
+    }
+
+    /// [`Film::splat_values`] with pixel `i`'s filter `filters[i]`.
+    pub fn splat_values_each<const K: usize>(
+        &self,
+        filters: &[Gaussian],
+        values: impl Fn(usize) -> [f64; K] + Sync,
+    ) -> Vec<[f64; K]> {
+        self.splat_by(|i| filters.get(i), values)
+    }
+
+    /// The splat of `values` with pixel `i`'s filter `at(i)` (none: the pixel splats
+    /// nothing).
+    fn splat_by<'a, const K: usize>(
+        &self,
+        at: impl Fn(usize) -> Option<&'a Gaussian> + Sync,
+        values: impl Fn(usize) -> [f64; K] + Sync,
+    ) -> Vec<[f64; K]> {
         let (w, h) = (self.width as usize, self.height as usize);
         // Each band of rows splats into a buffer with a margin as deep as its filters reach.
         let bands: Vec<(usize, Vec<[f64; K]>)> = (0..h.div_ceil(BAND))
@@ -581,7 +613,7 @@ impl Film {
             .map(|b| {
                 let (y0, y1) = (b * BAND, ((b + 1) * BAND).min(h));
                 let reach = (y0 * w..y1 * w)
-                    .filter_map(|i| filter.at(i))
+                    .filter_map(|i| at(i))
                     .map(Gaussian::reach_rows)
                     .max()
                     .unwrap_or(0);
@@ -592,7 +624,7 @@ impl Film {
                 for y in y0..y1 {
                     for x in 0..w {
                         let i = y * w + x;
-                        let Some(g) = filter.at(i) else { continue };
+                        let Some(g) = at(i) else { continue };
                         if self.count[i] == 0 {
                             continue;
                         }

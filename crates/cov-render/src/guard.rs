@@ -46,7 +46,7 @@ use glam::DVec3;
 use rayon::prelude::*;
 
 use crate::adaptive::{Guide, edge_clamp};
-use crate::film::{Film, Filter, Gaussian};
+use crate::film::{Film, Gaussian};
 use crate::metrics::REL_EPS;
 use crate::trace::luminance;
 
@@ -100,10 +100,7 @@ pub fn candidate(guide: &Guide, scale: f64, rows: Range<u32>) -> Vec<Gaussian> {
 /// `candidates` are [`candidates`] of the film's guide. Only the pixels of `rows` are
 /// estimated and chosen (a part of a render, the `parts` module); the others take the box.
 pub fn guarded(candidates: &[Vec<Gaussian>], film: &Film, rows: Range<u32>) -> Guarded {
-    let sums: Vec<Vec<(DVec3, f64)>> = candidates
-        .iter()
-        .map(|f| film.splat(&Filter::PerPixel(f.clone())))
-        .collect();
+    let sums: Vec<Vec<(DVec3, f64)>> = candidates.iter().map(|f| film.splat_each(f)).collect();
     let lum: Vec<Vec<[f64; 2]>> = sums
         .iter()
         .map(|acc| acc.par_iter().map(|&(s, n)| [luminance(s), n]).collect())
@@ -139,11 +136,7 @@ pub fn chosen_filters(
 ) -> Vec<Option<Gaussian>> {
     let lum: Vec<Vec<[f64; 2]>> = candidates
         .iter()
-        .map(|f| {
-            film.splat_values(&Filter::PerPixel(f.clone()), |i| {
-                [luminance(film.reflected[i]), f64::from(film.count[i])]
-            })
-        })
+        .map(|f| film.splat_values_each(f, |i| [luminance(film.reflected[i]), f64::from(film.count[i])]))
         .collect();
     filters_of(&choose(&lum, candidates, film, target, &rows), candidates)
 }
