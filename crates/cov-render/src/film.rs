@@ -613,7 +613,7 @@ impl Film {
             .map(|b| {
                 let (y0, y1) = (b * BAND, ((b + 1) * BAND).min(h));
                 let reach = (y0 * w..y1 * w)
-                    .filter_map(|i| at(i))
+                    .filter_map(&at)
                     .map(Gaussian::reach_rows)
                     .max()
                     .unwrap_or(0);
