@@ -146,7 +146,8 @@ impl Gaussian {
         // Unit eigenvector of l1.
         let (vx, vy) = if b.abs() > 1e-300 {
             let (x, y) = (l1 - d, b);
-            // `hypot` guards an overflow that finite covariances below 1e150 cannot reach.
+            // A plain square root; `hypot` only where the squares overflow (entries
+            // beyond about 1e154) or underflow to 0.
             let n = match (x * x + y * y).sqrt() {
                 n if n.is_finite() && n > 0.0 => n,
                 _ => x.hypot(y),
