@@ -16,9 +16,11 @@
 use std::path::Path;
 
 use glam::{DVec2, DVec3};
+use rayon::prelude::*;
 
 /// Largest side of a texture (texels), for images and procedural textures alike: bounds
-/// memory (a 4096² texture with its pyramid takes about 400 MB of f32).
+/// memory (a 4096² texture with its pyramid takes about 400 MB of f32; a scene with one
+/// peaked at 0.74 GB resident while it was built).
 pub const MAX_TEXTURE_SIDE: u32 = 4096;
 
 /// One level of the pyramid.
@@ -324,40 +326,46 @@ impl Level {
     fn new(w: usize, h: usize, rgb: Vec<[f32; 3]>) -> Level {
         let a: Vec<f64> = rgb.iter().map(|&c| lum(c)).collect();
         let (fw, fh) = (w as f64, h as f64);
-        let mut mom = Vec::with_capacity(w * h);
-        for y in 0..h {
-            for x in 0..w {
-                // The 3×3 neighbourhood, row 0 on top (wrapping).
-                let n: [[f64; 3]; 3] = std::array::from_fn(|r| {
-                    std::array::from_fn(|c| a[((y + h + r - 1) % h) * w + (x + w + c - 1) % w])
-                });
-                let mean = n.iter().flatten().sum::<f64>() / 9.0;
-                let var = n.iter().flatten().map(|v| (v - mean).powi(2)).sum::<f64>() / 9.0;
-                // Differences between neighbours inside the neighbourhood only, so that a
-                // constant neighbourhood has no gradient (then the variance bounds it):
-                // the six horizontal and six vertical pairs, per unit of u and of v (up).
-                let mut gu = 0.0;
-                let mut gv = 0.0;
-                for i in 0..3 {
-                    for j in 0..2 {
-                        gu += ((n[i][j + 1] - n[i][j]) * fw).powi(2) / 6.0;
-                        gv += ((n[j][i] - n[j + 1][i]) * fh).powi(2) / 6.0;
+        // Each column's left, own and right column (wrapping), found once.
+        let cols: Vec<[usize; 3]> = (0..w).map(|x| [(x + w - 1) % w, x, (x + 1) % w]).collect();
+        let (a, cols) = (&a, &cols);
+        // Rows in parallel, each texel's statistics as the texels are read one by one.
+        let mom = (0..h)
+            .into_par_iter()
+            .flat_map_iter(|y| {
+                let rows = [(y + h - 1) % h, y, (y + 1) % h];
+                (0..w).map(move |x| {
+                    // The 3×3 neighbourhood, row 0 on top (wrapping).
+                    let n: [[f64; 3]; 3] =
+                        std::array::from_fn(|r| std::array::from_fn(|c| a[rows[r] * w + cols[x][c]]));
+                    let mean = n.iter().flatten().sum::<f64>() / 9.0;
+                    let var = n.iter().flatten().map(|v| (v - mean).powi(2)).sum::<f64>() / 9.0;
+                    // Differences between neighbours inside the neighbourhood only, so that a
+                    // constant neighbourhood has no gradient (then the variance bounds it):
+                    // the six horizontal and six vertical pairs, per unit of u and of v (up).
+                    let mut gu = 0.0;
+                    let mut gv = 0.0;
+                    for i in 0..3 {
+                        for j in 0..2 {
+                            gu += ((n[i][j + 1] - n[i][j]) * fw).powi(2) / 6.0;
+                            gv += ((n[j][i] - n[j + 1][i]) * fh).powi(2) / 6.0;
+                        }
                     }
-                }
-                // The cross term from each 2×2 sub-square's mean differences, held to
-                // |guv| ≤ √(gu gv).
-                let mut guv = 0.0;
-                for r in 0..2 {
-                    for c in 0..2 {
-                        let du = (n[r][c + 1] - n[r][c] + n[r + 1][c + 1] - n[r + 1][c]) * 0.5 * fw;
-                        let dv = (n[r][c] - n[r + 1][c] + n[r][c + 1] - n[r + 1][c + 1]) * 0.5 * fh;
-                        guv += du * dv / 4.0;
+                    // The cross term from each 2×2 sub-square's mean differences, held to
+                    // |guv| ≤ √(gu gv).
+                    let mut guv = 0.0;
+                    for r in 0..2 {
+                        for c in 0..2 {
+                            let du = (n[r][c + 1] - n[r][c] + n[r + 1][c + 1] - n[r + 1][c]) * 0.5 * fw;
+                            let dv = (n[r][c] - n[r + 1][c] + n[r][c + 1] - n[r + 1][c + 1]) * 0.5 * fh;
+                            guv += du * dv / 4.0;
+                        }
                     }
-                }
-                let lim = (gu * gv).sqrt();
-                mom.push([mean, var, gu, guv.clamp(-lim, lim), gv].map(|v| v as f32));
-            }
-        }
+                    let lim = (gu * gv).sqrt();
+                    [mean, var, gu, guv.clamp(-lim, lim), gv].map(|v| v as f32)
+                })
+            })
+            .collect();
         Level { w, h, rgb, mom }
     }
 
