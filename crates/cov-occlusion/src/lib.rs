@@ -225,16 +225,26 @@ impl Texture {
     pub fn from_moments(mean: f64, mean_sq: f64, grad: [f64; 3]) -> Result<Self, CovError> {
         cov_core::arg!(Self::NAME, mean).finite()?;
         cov_core::arg!(Self::NAME, mean_sq).non_negative()?;
-        let [gxx, gxy, gyy] = grad;
         // The same checks as `new`, on the gradient moments.
-        Self::new(gxx, gxy, gyy)?;
+        Self::new(grad[0], grad[1], grad[2])?;
+        let [sxx, sxy, syy] = Self::moments_spectrum(mean, mean_sq, grad);
+        Self::new(sxx, sxy, syy)
+    }
+
+    /// The spectrum covariance `[sxx, sxy, syy]` of [`Texture::from_moments`], without its
+    /// checks: for a caller that reads many averages known to be valid (finite, `mean_sq ≥
+    /// 0`, `grad` PSD: a renderer's mip-mapped moments) and checks what it makes of them
+    /// once ([`Texture::new`]). For such inputs the result is finite and PSD, and the same
+    /// to the bit as `from_moments`'s.
+    #[inline]
+    pub fn moments_spectrum(mean: f64, mean_sq: f64, grad: [f64; 3]) -> [f64; 3] {
         let p = mean_sq - mean * mean;
         if p <= 1e-12 * mean_sq {
-            return Self::new(0.0, 0.0, 0.0);
+            return [0.0; 3];
         }
         let amp = (2.0 * p).sqrt();
         let k = amp / (mean.abs() + amp) / (FOUR_PI_SQ * p);
-        Self::new(k * gxx, k * gxy, k * gyy)
+        grad.map(|g| k * g)
     }
 
     /// The spectrum covariance `[sxx, sxy, syy]` ((cycles/m)²) this texture adds.

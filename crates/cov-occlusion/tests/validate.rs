@@ -97,3 +97,22 @@ fn bad_parameters_are_rejected() {
     assert!(ThickOccluder::new(1.0, 0, 0.1).is_err());
     assert!(ThickOccluder::new(f64::INFINITY, 2, 0.1).is_err());
 }
+
+proptest::proptest! {
+    /// The unchecked spectrum a renderer takes per texture lookup is `from_moments`'s to
+    /// the bit, on valid averages (`mean_sq ≥ mean²`, PSD gradient moments), and is PSD.
+    #[test]
+    fn moments_spectrum_is_from_moments_unchecked(
+        mean in -2.0f64..2.0,
+        var in 0.0f64..1.0,
+        gxx in 0.0f64..1e4,
+        gyy in 0.0f64..1e4,
+        rho in -1.0f64..1.0,
+    ) {
+        let grad = [gxx, rho * (gxx * gyy).sqrt(), gyy];
+        let mean_sq = mean * mean + var;
+        let s = Texture::moments_spectrum(mean, mean_sq, grad);
+        proptest::prop_assert_eq!(s, Texture::from_moments(mean, mean_sq, grad).unwrap().spectrum());
+        proptest::prop_assert!(s[0] >= 0.0 && s[2] >= 0.0 && s[1] * s[1] <= s[0] * s[2] * (1.0 + 1e-12));
+    }
+}

@@ -82,7 +82,7 @@ fn guard(c: &mut Criterion) {
         g.bench_function("path tracing, 4 spp", |b| {
             b.iter(|| pool.install(|| black_box(sample())))
         });
-        g.bench_function("candidates (3 scales, edge clamp)", |b| {
+        g.bench_function("candidates (guard::SCALES, edge clamp)", |b| {
             b.iter(|| pool.install(|| black_box(candidates(&guide, 0..h))))
         });
         g.bench_function("pilot choice (luminance splats)", |b| {

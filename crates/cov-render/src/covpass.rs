@@ -175,7 +175,8 @@ fn source(layout: usize, s: f64) -> Result<AnyCov, CovError> {
 pub type Block = [f64; 4];
 
 /// The spectrum of the texture at `hit` in the frame `(x_out, d_out × x_out)` of the
-/// outgoing ray `d_out`: `Texture::from_moments` of the texture's statistics band-limited
+/// outgoing ray `d_out`: `Texture::from_moments`'s spectrum (`Texture::moments_spectrum`)
+/// of the texture's statistics band-limited
 /// at `band`, at lookups over `region` (m on the surface; crate::texture), enveloped in the
 /// surface's `(u, v)` frame and then carried to the tangent plane and to the ray (the
 /// inverse projection `x_surface = x_ray / cos_o` along the plane of incidence,
@@ -227,8 +228,11 @@ fn texture_window(
     // coefficient (1 for stripes everywhere the same way, 0 for a checker's two edges),
     // scaled to the envelope, so the envelope stays positive semi-definite.
     let (mut e, mut cross, mut norm) = ([0.0f64; 3], 0.0, 0.0);
+    // The moments are the pyramid's averages (finite, `mean_sq ≥ 0`, gradients PSD by
+    // construction): their spectra are made unchecked, and the envelope is checked once,
+    // below.
     for m in tex.moments(hit.uv, band * per_m, region * per_m) {
-        let [xx, xy, yy] = Texture::from_moments(m.mean, m.mean_sq, m.grad)?.spectrum();
+        let [xx, xy, yy] = Texture::moments_spectrum(m.mean, m.mean_sq, m.grad);
         e[0] = e[0].max(xx);
         e[2] = e[2].max(yy);
         cross += xy;

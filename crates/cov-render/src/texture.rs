@@ -398,7 +398,15 @@ impl Level {
         let y = (1.0 - (st.y - st.y.floor())) * self.h as f64 - 0.5;
         let (x0, y0) = (x.floor(), y.floor());
         let (fx, fy) = (x - x0, y - y0);
-        let wrap = |i: f64, n: usize| (i as i64).rem_euclid(n as i64) as usize;
+        // The texel index, wrapped: no division where it lies in the level already.
+        let wrap = |i: f64, n: usize| {
+            let i = i as i64;
+            if (0..n as i64).contains(&i) {
+                i as usize
+            } else {
+                i.rem_euclid(n as i64) as usize
+            }
+        };
         let (xa, xb) = (wrap(x0, self.w), wrap(x0 + 1.0, self.w));
         let (ya, yb) = (wrap(y0, self.h), wrap(y0 + 1.0, self.h));
         let (p, q, r, s) = (
