@@ -54,17 +54,19 @@ use crate::trace::luminance;
 /// doubles the std; 1/16 quarters it), widest first; the box is the last candidate.
 pub const SCALES: [f64; 4] = [1.0, 0.25, 0.0625, 0.015625];
 
-/// How many of [`SCALES`] (the widest) compete for every pixel. The narrowest, `F₀/64`
-/// (std at most 1 px), only stands in for the box: the reconstruction ([`guarded`])
-/// takes it where the box would win and its estimated error is lower still, the last
-/// step before the box where the guard rejects the wider filters, in a pixel of two
-/// samples or more (with one, the box's error is read off the neighbourhood, and a fine
-/// checker the pass was blind to then lost to the stand-in: 1.84× uniform sampling's
-/// error at 1 spp in `the_guard_protects_a_blind_pass`, against 1.10× without it). Where a wider filter
-/// wins, it would be one more noisy estimate to win by chance (measured: competing with
-/// them, it raised glossy's error by 3–6% from 16 spp up). A pilot's choice
-/// ([`chosen_filters`]) does not consider it: the allocation would take it for a filter,
-/// and the pixel would lose the floor of samples that a pixel choosing the box keeps.
+/// How many of [`SCALES`] (the widest) compete for every pixel.
+///
+/// The narrowest, `F₀/64` (std at most 1 px), only stands in for the box. The
+/// reconstruction ([`guarded`]) takes it where the box would win and its estimated error
+/// is lower still: the last step before the box where the guard rejects the wider
+/// filters. Where a wider filter wins, it would be one more noisy estimate to win by
+/// chance (measured: competing with them, it raised glossy's error by 3–6% from 16 spp
+/// up). It needs a pixel of two samples or more: with one, the box's error is read off
+/// the neighbourhood, and a fine checker the pass was blind to then lost to the stand-in
+/// (1.84× uniform sampling's error at 1 spp in `the_guard_protects_a_blind_pass`, against
+/// 1.10× without it). A pilot's choice ([`chosen_filters`]) does not consider it: the
+/// allocation would take it for a filter, and the pixel would lose the floor of samples
+/// that a pixel choosing the box keeps.
 pub const PILOT_SCALES: usize = 3;
 
 /// What the guard chose, per pixel.
