@@ -176,12 +176,11 @@ pub type Block = [f64; 4];
 
 /// The spectrum of the texture at `hit` in the frame `(x_out, d_out × x_out)` of the
 /// outgoing ray `d_out`: `Texture::from_moments`'s spectrum (`Texture::moments_spectrum`)
-/// of the texture's statistics band-limited
-/// at `band`, at lookups over `region` (m on the surface; crate::texture), enveloped in the
-/// surface's `(u, v)` frame and then carried to the tangent plane and to the ray (the
-/// inverse projection `x_surface = x_ray / cos_o` along the plane of incidence,
-/// docs/physics.md section 3). `None` without a texture or where the surface's
-/// coordinates are degenerate.
+/// of the texture's statistics band-limited at `band`, at lookups over `region` (m on the
+/// surface; crate::texture), enveloped in the surface's `(u, v)` frame and then carried
+/// to the tangent plane and to the ray (the inverse projection `x_surface = x_ray / cos_o`
+/// along the plane of incidence, docs/physics.md section 3). `None` without a texture or
+/// where the surface's coordinates are degenerate.
 fn texture_window(
     world: &World,
     hit: &Hit,

@@ -380,6 +380,12 @@ fn box3(w: i64, h: i64, v: &[f64], rows: &Range<u32>) -> Vec<f64> {
 mod tests {
     use super::*;
 
+    /// A standard normal number (Box–Muller).
+    fn normal(rng: &mut impl rand::Rng) -> f64 {
+        let (u, v): (f64, f64) = (rng.random::<f64>().max(1e-300), rng.random());
+        (-2.0 * u.ln()).sqrt() * (std::f64::consts::TAU * v).cos()
+    }
+
     /// A film of one sample per pixel whose luminance is `f(x, y)` (grey radiance; the
     /// luminance of grey `v` is `v`).
     fn one_sample(w: u32, h: u32, f: impl Fn(u32, u32) -> f64) -> Film {
@@ -404,7 +410,7 @@ mod tests {
     /// wider three alone. The pilot's choice never takes it.
     #[test]
     fn the_narrowest_candidate_is_the_reconstructions_alone() {
-        use rand::{Rng, SeedableRng};
+        use rand::SeedableRng;
         let (w, h, n) = (64u32, 48u32, 16u32);
         let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(9);
         let truth = |x: u32| 2.0 + 0.3 * (std::f64::consts::TAU * (f64::from(x) + 0.5) / 8.0).sin();
@@ -414,8 +420,7 @@ mod tests {
                 let i = (y * w + x) as usize;
                 let (mut s, mut s2, mut top) = (0.0, 0.0, 0.0);
                 for k in 0..n {
-                    let (u, v): (f64, f64) = (rng.random::<f64>().max(1e-300), rng.random());
-                    let v = truth(x) + 0.4 * (-2.0 * u.ln()).sqrt() * (std::f64::consts::TAU * v).cos();
+                    let v = truth(x) + 0.4 * normal(&mut rng);
                     s += v;
                     s2 += v * v;
                     if k >= n / 2 {
@@ -488,15 +493,10 @@ mod tests {
                 assert_eq!(v[y * 32 + x], 0.0, "({x}, {y})");
             }
         }
-        use rand::{Rng, SeedableRng};
+        use rand::SeedableRng;
         let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(3);
         let n = 256;
-        let gauss: Vec<f64> = (0..n * n)
-            .map(|_| {
-                let (u, v): (f64, f64) = (rng.random::<f64>().max(1e-300), rng.random());
-                (-2.0 * u.ln()).sqrt() * (std::f64::consts::TAU * v).cos()
-            })
-            .collect();
+        let gauss: Vec<f64> = (0..n * n).map(|_| normal(&mut rng)).collect();
         let film = one_sample(n as u32, n as u32, |x, y| {
             1.0 + 0.1 * gauss[(y * n as u32 + x) as usize]
         });

@@ -19,8 +19,8 @@ use glam::{DVec2, DVec3};
 use rayon::prelude::*;
 
 /// Largest side of a texture (texels), for images and procedural textures alike: bounds
-/// memory (a 4096² texture with its pyramid takes about 400 MB of f32; a scene with one
-/// peaked at 0.74 GB resident while it was built).
+/// memory (a texture with its pyramid holds 32 bytes a texel, its colour and five moments
+/// in f32, times 4/3: about 0.7 GB at 4096²; a scene with one peaked at 0.71 GB resident).
 pub const MAX_TEXTURE_SIDE: u32 = 4096;
 
 /// One level of the pyramid.
@@ -328,44 +328,41 @@ impl Level {
         let (fw, fh) = (w as f64, h as f64);
         // Each column's left, own and right column (wrapping), found once.
         let cols: Vec<[usize; 3]> = (0..w).map(|x| [(x + w - 1) % w, x, (x + 1) % w]).collect();
-        let (a, cols) = (&a, &cols);
-        // Rows in parallel, each texel's statistics as the texels are read one by one.
-        let mom = (0..h)
-            .into_par_iter()
-            .flat_map_iter(|y| {
-                let rows = [(y + h - 1) % h, y, (y + 1) % h];
-                (0..w).map(move |x| {
-                    // The 3×3 neighbourhood, row 0 on top (wrapping).
-                    let n: [[f64; 3]; 3] =
-                        std::array::from_fn(|r| std::array::from_fn(|c| a[rows[r] * w + cols[x][c]]));
-                    let mean = n.iter().flatten().sum::<f64>() / 9.0;
-                    let var = n.iter().flatten().map(|v| (v - mean).powi(2)).sum::<f64>() / 9.0;
-                    // Differences between neighbours inside the neighbourhood only, so that a
-                    // constant neighbourhood has no gradient (then the variance bounds it):
-                    // the six horizontal and six vertical pairs, per unit of u and of v (up).
-                    let mut gu = 0.0;
-                    let mut gv = 0.0;
-                    for i in 0..3 {
-                        for j in 0..2 {
-                            gu += ((n[i][j + 1] - n[i][j]) * fw).powi(2) / 6.0;
-                            gv += ((n[j][i] - n[j + 1][i]) * fh).powi(2) / 6.0;
-                        }
+        // Rows in parallel, written in place.
+        let mut mom = vec![[0f32; 5]; w * h];
+        mom.par_chunks_mut(w).enumerate().for_each(|(y, row)| {
+            let rows = [(y + h - 1) % h, y, (y + 1) % h];
+            for (x, out) in row.iter_mut().enumerate() {
+                // The 3×3 neighbourhood, row 0 on top (wrapping).
+                let n: [[f64; 3]; 3] =
+                    std::array::from_fn(|r| std::array::from_fn(|c| a[rows[r] * w + cols[x][c]]));
+                let mean = n.iter().flatten().sum::<f64>() / 9.0;
+                let var = n.iter().flatten().map(|v| (v - mean).powi(2)).sum::<f64>() / 9.0;
+                // Differences between neighbours inside the neighbourhood only, so that a
+                // constant neighbourhood has no gradient (then the variance bounds it):
+                // the six horizontal and six vertical pairs, per unit of u and of v (up).
+                let mut gu = 0.0;
+                let mut gv = 0.0;
+                for i in 0..3 {
+                    for j in 0..2 {
+                        gu += ((n[i][j + 1] - n[i][j]) * fw).powi(2) / 6.0;
+                        gv += ((n[j][i] - n[j + 1][i]) * fh).powi(2) / 6.0;
                     }
-                    // The cross term from each 2×2 sub-square's mean differences, held to
-                    // |guv| ≤ √(gu gv).
-                    let mut guv = 0.0;
-                    for r in 0..2 {
-                        for c in 0..2 {
-                            let du = (n[r][c + 1] - n[r][c] + n[r + 1][c + 1] - n[r + 1][c]) * 0.5 * fw;
-                            let dv = (n[r][c] - n[r + 1][c] + n[r][c + 1] - n[r + 1][c + 1]) * 0.5 * fh;
-                            guv += du * dv / 4.0;
-                        }
+                }
+                // The cross term from each 2×2 sub-square's mean differences, held to
+                // |guv| ≤ √(gu gv).
+                let mut guv = 0.0;
+                for r in 0..2 {
+                    for c in 0..2 {
+                        let du = (n[r][c + 1] - n[r][c] + n[r + 1][c + 1] - n[r + 1][c]) * 0.5 * fw;
+                        let dv = (n[r][c] - n[r + 1][c] + n[r][c + 1] - n[r + 1][c + 1]) * 0.5 * fh;
+                        guv += du * dv / 4.0;
                     }
-                    let lim = (gu * gv).sqrt();
-                    [mean, var, gu, guv.clamp(-lim, lim), gv].map(|v| v as f32)
-                })
-            })
-            .collect();
+                }
+                let lim = (gu * gv).sqrt();
+                *out = [mean, var, gu, guv.clamp(-lim, lim), gv].map(|v| v as f32);
+            }
+        });
         Level { w, h, rgb, mom }
     }
 
