@@ -38,25 +38,14 @@ impl Axis {
 
     /// Lower-case name as used in tables and RON files (`"x"`, `"y"`, `"u"`, `"v"`, `"t"`).
     pub fn name(self) -> &'static str {
-        match self {
-            Axis::X => "x",
-            Axis::Y => "y",
-            Axis::U => "u",
-            Axis::V => "v",
-            Axis::T => "t",
-        }
+        ["x", "y", "u", "v", "t"][self as usize]
     }
 
     /// Parses a lower- or upper-case axis name.
     pub fn from_name(name: &str) -> Option<Axis> {
-        match name {
-            "x" | "X" => Some(Axis::X),
-            "y" | "Y" => Some(Axis::Y),
-            "u" | "U" => Some(Axis::U),
-            "v" | "V" => Some(Axis::V),
-            "t" | "T" => Some(Axis::T),
-            _ => None,
-        }
+        Axis::ALL
+            .into_iter()
+            .find(|a| a.name().eq_ignore_ascii_case(name))
     }
 
     /// Unit of the primal coordinate along this axis.
@@ -123,12 +112,7 @@ impl AxisSet {
     /// The smallest layout size (2, 3, 4 or 5) that contains every axis of the set.
     pub fn smallest_layout(self) -> usize {
         let spatial = self.contains(Axis::Y) || self.contains(Axis::V);
-        match (spatial, self.contains(Axis::T)) {
-            (false, false) => 2,
-            (false, true) => 3,
-            (true, false) => 4,
-            (true, true) => 5,
-        }
+        2 + 2 * usize::from(spatial) + usize::from(self.contains(Axis::T))
     }
 }
 

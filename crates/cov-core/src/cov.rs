@@ -87,11 +87,6 @@ impl<const N: usize> Cov<N> {
         axis_index(N, axis)
     }
 
-    /// Whether this layout has `axis`.
-    pub fn has(axis: Axis) -> bool {
-        axis_index(N, axis).is_ok()
-    }
-
     /// Entry `Σ_ij` by index. Indices must be `< N` (panics otherwise: a programming error,
     /// never user input; use [`Cov::at`] for axis names).
     #[inline(always)]
@@ -153,14 +148,14 @@ impl<const N: usize> Cov<N> {
     pub fn gaussian(stds: [f64; N]) -> Result<Self, CovError> {
         let mut c = Self::zeros();
         for (i, s) in stds.iter().enumerate() {
-            let name = Self::axes()[i].name();
+            let out_of_range = |expected: &str| CovError::OutOfRange {
+                operator: "Cov::gaussian".into(),
+                parameter: format!("std.{}", Self::axes()[i].name()),
+                value: *s,
+                expected: expected.into(),
+            };
             if s.is_nan() || *s <= 0.0 {
-                return Err(CovError::OutOfRange {
-                    operator: "Cov::gaussian".into(),
-                    parameter: format!("std.{name}"),
-                    value: *s,
-                    expected: "must be > 0 (f64::INFINITY for a constant axis)".into(),
-                });
+                return Err(out_of_range("must be > 0 (f64::INFINITY for a constant axis)"));
             }
             let v = if s.is_infinite() {
                 0.0
@@ -168,12 +163,7 @@ impl<const N: usize> Cov<N> {
                 1.0 / (FOUR_PI_SQ * s * s)
             };
             if !v.is_finite() {
-                return Err(CovError::OutOfRange {
-                    operator: "Cov::gaussian".into(),
-                    parameter: format!("std.{name}"),
-                    value: *s,
-                    expected: "too small: 1/(4π² s²) overflows f64".into(),
-                });
+                return Err(out_of_range("too small: 1/(4π² s²) overflows f64"));
             }
             c.set(i, i, v);
         }
@@ -334,21 +324,16 @@ impl<const N: usize> Cov<N> {
         // scale is a power of two: scaling is exact, the same bits as unscaled.
         let mut a = self.to_small();
         let largest = a.iter().flatten().fold(0.0f64, |m, v| m.max(v.abs()));
-        let scale = if largest > 0.0 && largest.is_finite() {
-            2f64.powi(largest.log2().floor() as i32)
+        // 1 (exact) where Σ is 0 or not finite, or the power of two underflows.
+        let p2 = 2f64.powi(largest.log2().floor() as i32);
+        let scale = if largest > 0.0 && largest.is_finite() && p2 > 0.0 {
+            p2
         } else {
-            0.0
+            1.0
         };
-        if scale > 0.0 && scale.is_finite() {
-            a.iter_mut().flatten().for_each(|v| *v /= scale);
-        }
+        a.iter_mut().flatten().for_each(|v| *v /= scale);
         let (vals, _) = sym_eigen(N, &a);
-        let mut out = [0.0; N];
-        out.copy_from_slice(&vals[..N]);
-        if scale > 0.0 && scale.is_finite() {
-            out.iter_mut().for_each(|v| *v *= scale);
-        }
-        out
+        std::array::from_fn(|i| vals[i] * scale)
     }
 
     /// Numerical health of Σ: finiteness, positive semi-definiteness, condition number.
@@ -497,18 +482,6 @@ impl<const N: usize> approx::RelativeEq for Cov<N> {
             .iter()
             .zip(other.packed())
             .all(|(a, b)| a.relative_eq(b, epsilon, max_relative))
-    }
-}
-
-impl<const N: usize> approx::UlpsEq for Cov<N> {
-    fn default_max_ulps() -> u32 {
-        4
-    }
-    fn ulps_eq(&self, other: &Self, epsilon: f64, max_ulps: u32) -> bool {
-        self.packed()
-            .iter()
-            .zip(other.packed())
-            .all(|(a, b)| a.ulps_eq(b, epsilon, max_ulps))
     }
 }
 

@@ -88,7 +88,7 @@ pub use operator::{Chain, Operator, Step, Trace};
 pub use query::{CovBlock, Filter, NYQUIST_K};
 pub use report::{Field, Report, ReportField};
 pub use spec::{Build, Checked, OperatorReader, OperatorSpec, Param, ParamValue, Registrar};
-pub use spectrum::{Concrete, Form, Spectrum, Turn, transverse_pairs};
+pub use spectrum::{Concrete, Form, Spectrum, Turn};
 
 /// serde, for the code `#[derive(OperatorSpec)]` generates.
 #[doc(hidden)]

@@ -1,6 +1,7 @@
 //! Queries: what a renderer reads off Σ (docs/physics.md section 4).
 
 use crate::Spectrum;
+use crate::spectrum::resolve;
 use std::fmt;
 
 use nalgebra::DMatrix;
@@ -33,11 +34,7 @@ impl<const N: usize> Cov<N> {
 
     /// Bandwidths along every axis of the layout, in order.
     pub fn bandwidths(&self) -> [f64; N] {
-        let mut out = [0.0; N];
-        for (i, o) in out.iter_mut().enumerate() {
-            *o = self.get(i, i).max(0.0).sqrt();
-        }
-        out
+        std::array::from_fn(|i| self.get(i, i).max(0.0).sqrt())
     }
 
     /// The sub-block on `axes` (in the given order): the spectrum's marginal, i.e. the
@@ -46,10 +43,10 @@ impl<const N: usize> Cov<N> {
     /// # Errors
     /// Missing or repeated axis, or an empty list.
     pub fn marginal(&self, axes: &[Axis]) -> Result<CovBlock, CovError> {
-        let idx = indices::<N>("marginal", axes)?;
+        let (idx, k) = resolve(N, "marginal", axes)?;
         let mut m = [[0.0; MAX]; MAX];
-        for (a, &i) in idx.iter().enumerate() {
-            for (b, &j) in idx.iter().enumerate() {
+        for (a, &i) in idx[..k].iter().enumerate() {
+            for (b, &j) in idx[..k].iter().enumerate() {
                 m[a][b] = self.get(i, j);
             }
         }
@@ -66,7 +63,7 @@ impl<const N: usize> Cov<N> {
     /// # Errors
     /// Missing or repeated axis, or an empty list.
     pub fn integrated(&self, keep: &[Axis]) -> Result<CovBlock, CovError> {
-        indices::<N>("integrated", keep)?;
+        resolve(N, "integrated", keep)?;
         let dropped: Vec<Axis> = Self::axes()
             .iter()
             .copied()
@@ -81,40 +78,11 @@ impl<const N: usize> Cov<N> {
 
     /// The whole matrix as a block over all axes.
     pub fn block(&self) -> CovBlock {
-        let mut m = [[0.0; MAX]; MAX];
-        for (i, row) in m.iter_mut().enumerate().take(N) {
-            for (j, v) in row.iter_mut().enumerate().take(N) {
-                *v = self.get(i, j);
-            }
-        }
         CovBlock {
             axes: Self::axes().to_vec(),
-            m,
+            m: self.to_small(),
         }
     }
-}
-
-fn indices<const N: usize>(op: &str, axes: &[Axis]) -> Result<Vec<usize>, CovError> {
-    if axes.is_empty() {
-        return Err(CovError::Shape {
-            what: op.into(),
-            expected: "at least one axis".into(),
-            got: "none".into(),
-        });
-    }
-    let mut idx = Vec::with_capacity(axes.len());
-    for a in axes {
-        let i = Cov::<N>::index(*a)?;
-        if idx.contains(&i) {
-            return Err(CovError::Shape {
-                what: op.into(),
-                expected: "distinct axes".into(),
-                got: format!("`{a}` twice"),
-            });
-        }
-        idx.push(i);
-    }
-    Ok(idx)
 }
 
 /// The primal reconstruction filter that matches a spectrum (see

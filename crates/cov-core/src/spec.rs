@@ -155,25 +155,6 @@ impl Param {
     ) -> Result<f64, CovError> {
         self.of(value).require(ok, expected)
     }
-
-    /// [`Param::require`] for element `k` of a list parameter (named `values[k]`).
-    ///
-    /// # Errors
-    /// [`CovError::NonFinite`] or [`CovError::OutOfRange`].
-    #[inline]
-    pub fn require_at(
-        &self,
-        k: usize,
-        value: f64,
-        ok: impl FnOnce(f64) -> bool,
-        expected: impl FnOnce() -> String,
-    ) -> Result<f64, CovError> {
-        let arg = Arg {
-            index: Some(k),
-            ..self.of(value)
-        };
-        arg.require(ok, expected)
-    }
 }
 
 /// A value given to a Rust constructor that is not a spec's field (an enum variant's
@@ -347,37 +328,25 @@ pub trait ParamValue {
     ) -> Result<(), CovError>;
 }
 
-impl ParamValue for f64 {
-    #[inline(always)]
-    fn check_param(
-        &self,
-        p: &Param,
-        ok: impl Fn(f64) -> bool,
-        expected: impl Fn() -> String,
-    ) -> Result<(), CovError> {
-        p.require(*self, ok, expected).map(|_| ())
-    }
-}
-
-macro_rules! integer_param {
+macro_rules! number_param {
     ($($t:ty),*) => {$(
         impl ParamValue for $t {
-            #[inline]
+            #[inline(always)]
             fn check_param(
                 &self,
                 p: &Param,
                 ok: impl Fn(f64) -> bool,
                 expected: impl Fn() -> String,
             ) -> Result<(), CovError> {
-                // Exact for every count a user may give (≤ 2⁵³).
-                #[allow(clippy::cast_precision_loss)]
+                // Exact for every count a user may give (≤ 2⁵³); the identity for `f64`.
+                #[allow(clippy::cast_precision_loss, clippy::unnecessary_cast)]
                 let v = *self as f64;
                 p.require(v, ok, expected).map(|_| ())
             }
         }
     )*};
 }
-integer_param!(u32, u64, usize, i32, i64);
+number_param!(f64, u32, u64, usize, i32, i64);
 
 impl<T: ParamValue> ParamValue for Option<T> {
     #[inline(always)]
@@ -402,7 +371,11 @@ impl ParamValue for [f64] {
         expected: impl Fn() -> String,
     ) -> Result<(), CovError> {
         for (k, &v) in self.iter().enumerate() {
-            p.require_at(k, v, &ok, &expected)?;
+            let arg = Arg {
+                index: Some(k),
+                ..p.of(v)
+            };
+            arg.require(&ok, &expected)?;
         }
         Ok(())
     }

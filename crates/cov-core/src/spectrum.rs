@@ -87,53 +87,30 @@ pub trait Spectrum: fmt::Debug {
         Concrete::Other
     }
 
-    // ---- raw kernels: indices resolved, parameters checked -----------------------
+    // ---- raw kernels: indices resolved, parameters checked. Each fails only with
+    // [`CovError::Overflow`] naming `op`, and leaves Σ unchanged when it does. --------
 
     /// Rule 1, `Σ' = Aᵀ Σ A`, with `a[l][j] = A_lj` (the first `dim` rows and columns).
-    ///
-    /// # Errors
-    /// [`CovError::Overflow`] naming `op`; Σ is left unchanged.
     fn raw_congruence(&mut self, op: &str, a: &Small) -> Result<(), CovError>;
     /// Rule 1, elementary shear `z'_i = z_i + s·z_j` (indices `i ≠ j`).
-    ///
-    /// # Errors
-    /// [`CovError::Overflow`] naming `op`; Σ is left unchanged.
     fn raw_shear(&mut self, op: &str, i: usize, j: usize, s: f64) -> Result<(), CovError>;
     /// Rule 1, scaling `z'_i = c·z_i`.
-    ///
-    /// # Errors
-    /// [`CovError::Overflow`] naming `op`; Σ is left unchanged.
     fn raw_scale(&mut self, op: &str, i: usize, c: f64) -> Result<(), CovError>;
     /// Rule 1, rotations by the same angle (`cos`, `sin`) in each plane of `planes`
     /// (pairs of distinct indices, the pairs disjoint).
-    ///
-    /// # Errors
-    /// [`CovError::Overflow`] naming `op`; Σ is left unchanged.
     fn raw_rotate(&mut self, op: &str, planes: &[(usize, usize)], cos: f64, sin: f64)
     -> Result<(), CovError>;
     /// Rule 2, `Σ_pp += W` for the distinct indices `p`, `W` symmetric PSD (`p.len()`
     /// rows and columns of `w`).
-    ///
-    /// # Errors
-    /// [`CovError::Overflow`] naming `op`; Σ is left unchanged.
     fn raw_add_window(&mut self, op: &str, p: &[usize], w: &Small) -> Result<(), CovError>;
     /// Rule 2 on one axis, `Σ_ii += w` (`w ≥ 0`): the common window, kept apart from
     /// [`Spectrum::raw_add_window`] because it is the hot path of every occluder.
-    ///
-    /// # Errors
-    /// [`CovError::Overflow`] naming `op`; Σ is left unchanged.
     fn raw_add_variance(&mut self, op: &str, i: usize, w: f64) -> Result<(), CovError>;
     /// Rule 3 along one axis `p` with lobe spectrum `s ≥ 0` (rule 4 is `s = 0`): the
     /// common lobe and integration, kept apart from [`Spectrum::raw_lobe`] for speed.
-    ///
-    /// # Errors
-    /// [`CovError::Overflow`] naming `op`; Σ is left unchanged.
     fn raw_lobe_1(&mut self, op: &str, p: usize, s: f64) -> Result<(), CovError>;
     /// Rule 3 along the distinct indices `p` with lobe spectrum `S` (symmetric PSD); rule
     /// 4 is `S = 0`.
-    ///
-    /// # Errors
-    /// [`CovError::Overflow`] naming `op`; Σ is left unchanged.
     fn raw_lobe(&mut self, op: &str, p: &[usize], s: &Small) -> Result<(), CovError>;
 
     // ---- layout ---------------------------------------------------------------------
@@ -160,7 +137,11 @@ pub trait Spectrum: fmt::Debug {
     /// The (position, direction) axis pairs of this layout: `[(x, u)]` in flatland,
     /// `[(x, u), (y, v)]` in 3D. Flatland operator definitions apply to each pair.
     fn transverse_pairs(&self) -> &'static [(Axis, Axis)] {
-        transverse_pairs(self.dim())
+        if self.dim() >= 4 {
+            &[(Axis::X, Axis::U), (Axis::Y, Axis::V)]
+        } else {
+            &[(Axis::X, Axis::U)]
+        }
     }
 
     /// The direction axes of this layout: `[u]` or `[u, v]`.
@@ -381,15 +362,6 @@ pub enum Concrete<'a> {
     Other,
 }
 
-/// The (position, direction) pairs of layout `n` (see [`Spectrum::transverse_pairs`]).
-pub fn transverse_pairs(n: usize) -> &'static [(Axis, Axis)] {
-    if n >= 4 {
-        &[(Axis::X, Axis::U), (Axis::Y, Axis::V)]
-    } else {
-        &[(Axis::X, Axis::U)]
-    }
-}
-
 /// Reads a `k × k` row-major symmetric PSD block (a window or lobe spectrum).
 #[inline(always)]
 pub(crate) fn block_from_slice(
@@ -547,6 +519,20 @@ impl Turn {
         }
         let (sin, cos) = angle.sin_cos();
         Ok(Turn { angle, cos, sin })
+    }
+
+    /// The rotation by the angle of the direction `(x, y)`, of any length: its cosine and
+    /// sine are the direction's components over its length, without [`Turn::new`]'s
+    /// `sin_cos`. `None` where the length is 0 or not finite (it is taken as
+    /// `√(x² + y²)`, so components beyond about 1e154 or below 1e-162 read as such).
+    #[inline]
+    pub fn towards(x: f64, y: f64) -> Option<Turn> {
+        let r = (x * x + y * y).sqrt();
+        (r > 0.0 && r.is_finite()).then(|| Turn {
+            angle: y.atan2(x),
+            cos: x / r,
+            sin: y / r,
+        })
     }
 
     /// The rotation back, by `-angle`: `(cos, -sin)`, without trigonometry. The same

@@ -257,3 +257,23 @@ fn validity_of_degenerate() {
     c.set(0, 0, f64::INFINITY);
     assert!(!c.validity().is_valid());
 }
+
+/// `Turn::towards` is the turn by the direction's angle, whatever its length: the same
+/// angle as `atan2`, a cosine and sine within 2 ulp of `Turn::new`'s; a zero or
+/// non-finite direction has none.
+#[test]
+fn a_turn_towards_a_direction() {
+    for k in 0..=200 {
+        let angle = -3.14 + 6.28 * f64::from(k) / 200.0;
+        let t = Turn::new(arg!("test", angle)).unwrap();
+        for len in [1e-150, 1e-3, 1.0, 7.5, 1e150] {
+            let d = Turn::towards(t.cos() * len, t.sin() * len).unwrap();
+            assert!((d.angle() - angle).abs() <= 4.0 * f64::EPSILON, "{angle} {len}");
+            assert!((d.cos() - t.cos()).abs() <= 2.0 * f64::EPSILON, "{angle} {len}");
+            assert!((d.sin() - t.sin()).abs() <= 2.0 * f64::EPSILON, "{angle} {len}");
+        }
+    }
+    for (x, y) in [(0.0, 0.0), (f64::NAN, 1.0), (f64::INFINITY, 0.0), (1e200, 1e200)] {
+        assert_eq!(Turn::towards(x, y), None, "{x} {y}");
+    }
+}

@@ -131,7 +131,8 @@ impl Project {
             (stringify!(frame_x), frame_x),
             (stringify!(normal), normal),
         ] {
-            if !v.is_finite() || (v.length() - 1.0).abs() > 1e-9 {
+            // `|v|² − 1 ≈ 2 (|v| − 1)` near 1: the length's 1e-9, without its square root.
+            if !v.is_finite() || (v.length_squared() - 1.0).abs() > 2e-9 {
                 return Err(CovError::OutOfRange {
                     operator: Self::NAME.into(),
                     parameter: name.into(),
@@ -154,12 +155,18 @@ impl Project {
         let frame_y = dir.cross(frame_x);
         let p = normal - normal.dot(dir) * dir;
         // At (near-)normal incidence every transverse axis is in the plane of incidence.
-        let angle = if p.length() <= 1e-12 {
-            0.0
+        // Elsewhere the turn comes from `p`'s components, without the trigonometry of an
+        // angle (`Turn::towards`).
+        let turn = if p.length_squared() <= 1e-24 {
+            None
         } else {
-            p.dot(frame_y).atan2(p.dot(frame_x))
+            Turn::towards(p.dot(frame_x), p.dot(frame_y))
         };
-        Self::with_angle(cos, angle)
+        match turn {
+            // `cos ≤ 1` by construction; 0 (a grazing ray) is the spec's error.
+            Some(turn) if cos > 0.0 => Ok(Project { cos, turn }),
+            _ => Self::new(cos),
+        }
     }
 
     /// `|cos θ|`.
