@@ -347,7 +347,7 @@ impl Operator for Reflect {
         self.curvature.apply_oblique(cov, self.project.cos(), 1.0)?;
         Operator::apply(&Mirror, cov)?;
         self.lobe.convolve(cov)?;
-        if self.turn.angle() != 0.0 {
+        if !self.turn.is_zero() {
             cov.rotate_frame_by(self.turn)?;
         }
         self.curvature.apply_oblique(cov, self.unproject.cos(), -1.0)?;
@@ -355,7 +355,7 @@ impl Operator for Reflect {
     }
     fn requires(&self) -> cov_core::AxisSet {
         let r = Operator::requires(&self.curvature);
-        if self.turn.angle() != 0.0 {
+        if !self.turn.is_zero() {
             r.union(cov_core::AxisSet::SPACE)
         } else {
             r

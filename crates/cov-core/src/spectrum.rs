@@ -485,11 +485,31 @@ pub(crate) fn two_axes(n: usize, op: &str, a: Axis, b: Axis) -> Result<(usize, u
 /// assert!(err.contains("MyOperator") && err.contains("angle"));
 /// # Ok::<(), cov_core::CovError>(())
 /// ```
-#[derive(Clone, Copy, Debug, PartialEq)]
+///
+/// Two turns are equal when their cosines and sines are.
+#[derive(Clone, Copy)]
 pub struct Turn {
+    /// The angle, or NaN for a turn made from a direction ([`Turn::towards`]), whose
+    /// angle is found when asked for.
     angle: f64,
     cos: f64,
     sin: f64,
+}
+
+impl PartialEq for Turn {
+    fn eq(&self, other: &Turn) -> bool {
+        self.cos == other.cos && self.sin == other.sin
+    }
+}
+
+impl std::fmt::Debug for Turn {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Turn")
+            .field("angle", &self.angle())
+            .field("cos", &self.cos)
+            .field("sin", &self.sin)
+            .finish()
+    }
 }
 
 impl Turn {
@@ -523,16 +543,24 @@ impl Turn {
 
     /// The rotation by the angle of the direction `(x, y)`, of any length: its cosine and
     /// sine are the direction's components over its length, without [`Turn::new`]'s
-    /// `sin_cos`. `None` where the length is 0 or not finite (it is taken as
-    /// `√(x² + y²)`, so components beyond about 1e154 or below 1e-162 read as such).
+    /// `sin_cos`; its angle (an `atan2`) is computed only if [`Turn::angle`] asks for it.
+    /// `None` where the length is 0 or not finite (it is taken as `√(x² + y²)`, so
+    /// components beyond about 1e154 or below 1e-162 read as such).
     #[inline]
     pub fn towards(x: f64, y: f64) -> Option<Turn> {
         let r = (x * x + y * y).sqrt();
         (r > 0.0 && r.is_finite()).then(|| Turn {
-            angle: y.atan2(x),
+            angle: f64::NAN,
             cos: x / r,
             sin: y / r,
         })
+    }
+
+    /// Whether it turns nothing (`cos = 1`, `sin = ±0`: an angle of ±0, or a direction
+    /// along `x`), without computing an angle.
+    #[inline]
+    pub fn is_zero(&self) -> bool {
+        self.sin == 0.0 && self.cos == 1.0
     }
 
     /// The rotation back, by `-angle`: `(cos, -sin)`, without trigonometry. The same
@@ -546,9 +574,14 @@ impl Turn {
         }
     }
 
-    /// The angle (radians).
+    /// The angle (radians): as given to [`Turn::new`], or in `[−π, π]` for a turn made
+    /// from a direction ([`Turn::towards`]).
     pub fn angle(&self) -> f64 {
-        self.angle
+        if self.angle.is_nan() {
+            self.sin.atan2(self.cos)
+        } else {
+            self.angle
+        }
     }
 
     /// `cos(angle)`.

@@ -264,7 +264,7 @@ fn validity_of_degenerate() {
 #[test]
 fn a_turn_towards_a_direction() {
     for k in 0..=200 {
-        let angle = -3.14 + 6.28 * f64::from(k) / 200.0;
+        let angle = -3.0 + 6.0 * f64::from(k) / 200.0;
         let t = Turn::new(arg!("test", angle)).unwrap();
         for len in [1e-150, 1e-3, 1.0, 7.5, 1e150] {
             let d = Turn::towards(t.cos() * len, t.sin() * len).unwrap();
@@ -275,5 +275,21 @@ fn a_turn_towards_a_direction() {
     }
     for (x, y) in [(0.0, 0.0), (f64::NAN, 1.0), (f64::INFINITY, 0.0), (1e200, 1e200)] {
         assert_eq!(Turn::towards(x, y), None, "{x} {y}");
+    }
+    // A turn is zero exactly where its angle is ±0.
+    let turns = |angle: f64| Turn::new(arg!("test", angle)).unwrap();
+    for (t, zero) in [
+        (Turn::ZERO, true),
+        (turns(0.0), true),
+        (turns(-0.0), true),
+        (turns(1e-300), false),
+        (turns(std::f64::consts::TAU), false),
+        (Turn::towards(2.0, 0.0).unwrap(), true),
+        (Turn::towards(2.0, -0.0).unwrap(), true),
+        (Turn::towards(-1.0, 0.0).unwrap(), false),
+        (Turn::towards(1.0, 1e-300).unwrap(), false),
+    ] {
+        assert_eq!(t.is_zero(), zero, "{t:?}");
+        assert_eq!(t.is_zero(), t.angle() == 0.0, "{t:?}");
     }
 }

@@ -392,7 +392,7 @@ impl Scatter {
 
 impl Operator for Scatter {
     fn apply(&self, cov: &mut dyn Spectrum) -> Result<(), CovError> {
-        if self.azimuth.angle() != 0.0 {
+        if !self.azimuth.is_zero() {
             cov.rotate_frame_by(self.azimuth)?;
         }
         cov.scale(Axis::X, self.cos)?;
@@ -408,7 +408,7 @@ impl Operator for Scatter {
         Ok(())
     }
     fn requires(&self) -> AxisSet {
-        if self.azimuth.angle() != 0.0 {
+        if !self.azimuth.is_zero() {
             AxisSet::SPACE
         } else {
             AxisSet::FLAT

@@ -69,15 +69,15 @@ use glam::DVec3;
 /// The frame turn of a projection: none at 0, so a flatland layout accepts it.
 #[inline(always)]
 fn rotate<S: Spectrum + ?Sized>(cov: &mut S, turn: Turn) -> Result<(), CovError> {
-    if turn.angle() != 0.0 {
+    if !turn.is_zero() {
         cov.rotate_frame_by(turn)
     } else {
         Ok(())
     }
 }
 
-fn needs(angle: f64) -> AxisSet {
-    if angle != 0.0 {
+fn needs(turn: Turn) -> AxisSet {
+    if !turn.is_zero() {
         AxisSet::SPACE
     } else {
         AxisSet::FLAT
@@ -188,7 +188,7 @@ impl Operator for Project {
         })
     }
     fn requires(&self) -> AxisSet {
-        needs(self.turn.angle())
+        needs(self.turn)
     }
 }
 
@@ -237,7 +237,7 @@ impl Operator for Unproject {
         })
     }
     fn requires(&self) -> AxisSet {
-        needs(self.turn.angle())
+        needs(self.turn)
     }
 }
 

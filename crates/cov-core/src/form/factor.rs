@@ -64,15 +64,9 @@ type Work<const N: usize> = [[f64; W]; N];
 /// approx::assert_relative_eq!(f.to_cov()?, c, max_relative = 1e-12);
 /// # Ok::<(), CovError>(())
 /// ```
-#[derive(Clone, Copy, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub struct CovFactor<const N: usize> {
     l: [[f64; N]; N],
-}
-
-impl<const N: usize> std::fmt::Debug for CovFactor<N> {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.debug_struct("CovFactor").field("l", &self.l).finish()
-    }
 }
 
 impl<const N: usize> Default for CovFactor<N> {
