@@ -181,7 +181,9 @@ impl<const N: usize> Packed<N> {
 }
 
 /// (cos, angle) of a projection from the ray direction, its frame x axis and the
-/// surface normal, as `Project::from_vectors` computes them.
+/// surface normal, as the C++ library computes them (an `atan2`, then `sin_cos` of the
+/// angle). The library's `Project::from_vectors` takes the turn's cosine and sine from the
+/// components instead, without either call (docs/speed.md).
 #[inline(always)]
 pub fn projection_angles(dir: [f64; 3], fx: [f64; 3], n: [f64; 3]) -> (f64, f64) {
     let dot = |a: [f64; 3], b: [f64; 3]| a[0] * b[0] + a[1] * b[1] + a[2] * b[2];

@@ -241,8 +241,8 @@ pub trait Spectrum: fmt::Debug {
 
     /// [`Spectrum::rotate_frame`] by a [`Turn`], whose cosine and sine were computed when
     /// it was built: an operator that turns the frame by a fixed angle builds its `Turn`
-    /// once and pays no trigonometry per application. The same result bits as
-    /// `rotate_frame(turn.angle())`.
+    /// once and pays no trigonometry per application. For a turn from [`Turn::new`], the
+    /// same result bits as `rotate_frame(turn.angle())`.
     ///
     /// # Errors
     /// [`CovError::MissingAxis`] in flatland (N = 2, 3).
@@ -486,7 +486,9 @@ pub(crate) fn two_axes(n: usize, op: &str, a: Axis, b: Axis) -> Result<(usize, u
 /// # Ok::<(), cov_core::CovError>(())
 /// ```
 ///
-/// Two turns are equal when their cosines and sines are.
+/// Two turns are equal when their cosines and sines are; their [`Turn::angle`]s may still
+/// differ in the last bits (a turn from [`Turn::new`] keeps its argument, one from
+/// [`Turn::towards`] takes the `atan2` of its sine and cosine).
 #[derive(Clone, Copy)]
 pub struct Turn {
     /// The angle, or NaN for a turn made from a direction ([`Turn::towards`]), whose
@@ -544,11 +546,17 @@ impl Turn {
     /// The rotation by the angle of the direction `(x, y)`, of any length: its cosine and
     /// sine are the direction's components over its length, without [`Turn::new`]'s
     /// `sin_cos`; its angle (an `atan2`) is computed only if [`Turn::angle`] asks for it.
-    /// `None` where the length is 0 or not finite (it is taken as `√(x² + y²)`, so
-    /// components beyond about 1e154 or below 1e-162 read as such).
+    /// `None` where the length is 0 or not finite. The length is `√(x² + y²)`, or
+    /// `hypot` where the squares' sum underflows to a subnormal or overflows (components
+    /// below about 1e-154 or above about 1e154), so the cosine and sine stay unit.
     #[inline]
     pub fn towards(x: f64, y: f64) -> Option<Turn> {
-        let r = (x * x + y * y).sqrt();
+        let r2 = x * x + y * y;
+        let r = if r2 >= f64::MIN_POSITIVE && r2.is_finite() {
+            r2.sqrt()
+        } else {
+            x.hypot(y)
+        };
         (r > 0.0 && r.is_finite()).then(|| Turn {
             angle: f64::NAN,
             cos: x / r,
@@ -557,14 +565,15 @@ impl Turn {
     }
 
     /// Whether it turns nothing (`cos = 1`, `sin = ±0`: an angle of ±0, or a direction
-    /// along `x`), without computing an angle.
+    /// along `+x`), without computing an angle.
     #[inline]
     pub fn is_zero(&self) -> bool {
         self.sin == 0.0 && self.cos == 1.0
     }
 
-    /// The rotation back, by `-angle`: `(cos, -sin)`, without trigonometry. The same
-    /// bits as `Turn::new(.., -angle)` wherever `sin` is odd to the bit, as glibc's is
+    /// The rotation back, by `-angle`: `(cos, -sin)`, without trigonometry. For a turn
+    /// from [`Turn::new`], the same bits as `Turn::new(.., -angle)` wherever `sin` is odd
+    /// to the bit, as glibc's is
     /// (`tests/turn.rs` checks it through the operators that use it).
     pub fn inverse(&self) -> Turn {
         Turn {

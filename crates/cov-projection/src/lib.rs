@@ -26,8 +26,9 @@
 //! | `RotateFrame` | `angle` | rad | required | finite | Angle, counter-clockwise x → y. |
 //! <!-- end of parameters -->
 //!
-//! [`Project::from_vectors`] computes `cos` and `angle` from the ray direction, the
-//! ray frame's `x` axis and the surface normal (glam `DVec3`).
+//! [`Project::from_vectors`] computes `cos` and the frame turn (its cosine and sine; the
+//! angle only if [`Project::angle`] asks) from the ray direction, the ray frame's `x`
+//! axis and the surface normal (glam `DVec3`).
 //!
 //! ```
 //! use cov_core::{Cov, Operator};
@@ -119,11 +120,13 @@ impl Project {
 
     /// From geometry: the ray direction `dir`, the ray frame's `x` axis `frame_x` (both
     /// unit, orthogonal; the frame's `y` is `dir × frame_x`) and the surface normal. The
-    /// angle turns `x` into the plane of incidence; at normal incidence it is 0.
+    /// turn takes `x` into the plane of incidence; at normal incidence it is none. Its
+    /// cosine and sine come from the normal's components, without trigonometry.
     ///
     /// # Errors
-    /// Non-unit or non-orthogonal inputs (tolerance 1e-9), non-finite components, or a
-    /// ray parallel to the surface (`cos = 0`).
+    /// Non-unit or non-orthogonal inputs (tolerance 1e-9 on `|v|` for a unit vector,
+    /// tested as `|v|²` within 2e-9 of 1; 1e-9 on `dir · frame_x`), non-finite components,
+    /// or a ray parallel to the surface (`cos = 0`).
     pub fn from_vectors(dir: DVec3, frame_x: DVec3, normal: DVec3) -> Result<Self, CovError> {
         // Each vector named by its identifier.
         for (name, v) in [
@@ -174,7 +177,8 @@ impl Project {
         self.cos
     }
 
-    /// Frame rotation (rad).
+    /// Frame rotation (rad). For a projection from [`Project::from_vectors`], an `atan2`
+    /// of the turn's sine and cosine at every call, in `[−π, π]`.
     pub fn angle(&self) -> f64 {
         self.turn.angle()
     }
