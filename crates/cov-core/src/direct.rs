@@ -1,9 +1,6 @@
-//! The fast path of [`crate::Chain`]: its operators run on a copy of Σ with one
-//! finiteness check at the end instead of a check after every step. Bodies written on
-//! `&mut dyn Spectrum` run here on the forms' unchecked kernels ([`Kernels`]); typed
-//! bodies ([`crate::typed!`]) get the concrete form and its checked kernels, inlined. Operators validate their parameters and resolve their axes as
-//! usual; a run that is not clean is repeated in checked mode by the caller, which reports
-//! the failing step exactly and leaves Σ as it was.
+//! The fast path of [`crate::Chain`] (`Direct`). Bodies written on `&mut dyn Spectrum`
+//! run here on the forms' unchecked kernels ([`Kernels`]); typed bodies
+//! ([`crate::typed!`]) get the concrete form and its checked kernels, inlined.
 
 use crate::form::Kernels;
 use crate::linalg::Small;
