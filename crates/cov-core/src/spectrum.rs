@@ -551,11 +551,15 @@ impl Turn {
     /// below about 1e-154 or above about 1e154), so the cosine and sine stay unit.
     #[inline]
     pub fn towards(x: f64, y: f64) -> Option<Turn> {
+        #[cold]
+        fn hypot(x: f64, y: f64) -> f64 {
+            x.hypot(y)
+        }
         let r2 = x * x + y * y;
-        let r = if r2 >= f64::MIN_POSITIVE && r2.is_finite() {
+        let r = if (f64::MIN_POSITIVE..=f64::MAX).contains(&r2) {
             r2.sqrt()
         } else {
-            x.hypot(y)
+            hypot(x, y)
         };
         (r > 0.0 && r.is_finite()).then(|| Turn {
             angle: f64::NAN,
