@@ -279,12 +279,7 @@ impl<const N: usize> Cov<N> {
             for j in i..N {
                 let v = self.get(i, j);
                 if !v.is_finite() {
-                    return Err(CovError::Overflow {
-                        operator: operator.into(),
-                        row: i,
-                        col: j,
-                        value: v,
-                    });
+                    return Err(CovError::overflow(operator, (i, j, v)));
                 }
             }
         }

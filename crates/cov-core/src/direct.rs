@@ -50,12 +50,7 @@ impl<K: Kernels> Direct<'_, K> {
         if self.0.all_finite() {
             Ok(())
         } else {
-            Err(CovError::Overflow {
-                operator: op.into(),
-                row: 0,
-                col: 0,
-                value: f64::NAN,
-            })
+            Err(CovError::overflow(op, (0, 0, f64::NAN)))
         }
     }
 }

@@ -103,6 +103,20 @@ pub enum CovError {
     },
 }
 
+impl CovError {
+    /// [`CovError::Overflow`] of `operator` at `(row, col, value)`, the first non-finite
+    /// entry.
+    #[cold]
+    pub(crate) fn overflow(operator: &str, (row, col, value): (usize, usize, f64)) -> CovError {
+        CovError::Overflow {
+            operator: operator.into(),
+            row,
+            col,
+            value,
+        }
+    }
+}
+
 /// A number as messages print it: plainly between `1e-4` and `1e6` (`0.25`, `1500`),
 /// else in scientific form with the fewest digits that read back exactly (`1e300`,
 /// `3.2e-9`), so that no message prints a 300-digit decimal.

@@ -375,12 +375,7 @@ fn step_error(index: usize, op: &dyn Operator, e: CovError) -> CovError {
 fn apply_step(index: usize, op: &dyn Operator, c: &mut dyn Spectrum) -> Result<(), CovError> {
     let result = op.apply(c).and_then(|()| match c.first_non_finite() {
         None => Ok(()),
-        Some((row, col, value)) => Err(CovError::Overflow {
-            operator: op.name().to_string(),
-            row,
-            col,
-            value,
-        }),
+        Some(at) => Err(CovError::overflow(op.name(), at)),
     });
     result.map_err(|e| step_error(index, op, e))
 }

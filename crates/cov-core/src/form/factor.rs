@@ -201,12 +201,7 @@ impl<const N: usize> CovFactor<N> {
         for i in 0..N {
             for c in 0..N {
                 if !self.l[i][c].is_finite() {
-                    return Err(CovError::Overflow {
-                        operator: operator.into(),
-                        row: i,
-                        col: c,
-                        value: self.l[i][c],
-                    });
+                    return Err(CovError::overflow(operator, (i, c, self.l[i][c])));
                 }
             }
         }

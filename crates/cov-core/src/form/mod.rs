@@ -82,14 +82,9 @@ pub(crate) trait Kernels: crate::Spectrum + Copy + Send + Sync + 'static {
 #[cold]
 #[inline(never)]
 fn overflowed<K: Kernels>(k: &mut K, op: &str, old: K) -> Result<(), crate::CovError> {
-    let (row, col, value) = k.first_non_finite().unwrap_or((0, 0, f64::NAN));
+    let at = k.first_non_finite().unwrap_or((0, 0, f64::NAN));
     *k = old;
-    Err(crate::CovError::Overflow {
-        operator: op.into(),
-        row,
-        col,
-        value,
-    })
+    Err(crate::CovError::overflow(op, at))
 }
 
 /// The checked raw kernels of [`crate::Spectrum`] for a form, each derived from the
