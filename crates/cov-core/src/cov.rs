@@ -95,6 +95,16 @@ impl<const N: usize> Cov<N> {
         self.p[Self::IX[i][j] as usize]
     }
 
+    /// [`Cov::get`] for the kernels: one 8-byte load, never merged with a neighbour's
+    /// into a 16-byte load, which could not be forwarded from the two 8-byte stores of the
+    /// kernel before and would wait for them (docs/speed.md, "Store forwarding").
+    #[inline(always)]
+    pub(crate) fn load(&self, i: usize, j: usize) -> f64 {
+        assert!(i < N && j < N, "index ({i},{j}) out of range for N = {N}");
+        // SAFETY: a reference to an element of `self.p`, valid and aligned for the read.
+        unsafe { std::ptr::read_volatile(&self.p[Self::IX[i][j] as usize]) }
+    }
+
     /// Sets `Σ_ij = Σ_ji = value` by index. Indices must be `< N`. This does not check
     /// positive semi-definiteness; kernels and [`Cov::from_matrix`] are the safe ways in.
     #[inline(always)]

@@ -71,18 +71,24 @@ impl<const N: usize> Kernels for Cov<N> {
     const ROTATION_STAYS_FINITE: bool = false;
 
     #[inline(always)]
-    fn k_shear(&mut self, i: usize, j: usize, s: f64) {
-        let col = self.shear_col(i, j, s);
-        for (k, v) in col.iter().enumerate() {
-            self.set(k, j, *v);
+    fn sheared(&self, i: usize, j: usize, s: f64) -> [f64; MAX] {
+        let mut col = [0.0; MAX];
+        for (k, c) in col.iter_mut().enumerate().take(N) {
+            *c = if k == j {
+                quadratic(self.load(j, j) + s * (2.0 * self.load(i, j) + s * self.load(i, i)))
+            } else {
+                self.load(k, j) + s * self.load(k, i)
+            };
         }
+        col
     }
     #[inline(always)]
-    fn k_scale(&mut self, i: usize, c: f64) {
-        let col = self.scale_col(i, c);
-        for (k, v) in col.iter().enumerate() {
-            self.set(k, i, *v);
+    fn scaled(&self, i: usize, c: f64) -> [f64; MAX] {
+        let mut col = [0.0; MAX];
+        for (k, v) in col.iter_mut().enumerate().take(N) {
+            *v = self.load(k, i) * if k == i { c * c } else { c };
         }
+        col
     }
     #[inline(always)]
     fn k_rotate(&mut self, i: usize, j: usize, c: f64, s: f64) {
@@ -90,7 +96,7 @@ impl<const N: usize> Kernels for Cov<N> {
     }
     #[inline(always)]
     fn k_add_variance(&mut self, i: usize, w: f64) {
-        let v = self.get(i, i) + w;
+        let v = self.load(i, i) + w;
         self.set(i, i, v);
     }
     #[inline(always)]
@@ -110,7 +116,7 @@ impl<const N: usize> Kernels for Cov<N> {
     fn line(&self, j: usize) -> [f64; MAX] {
         let mut line = [0.0; MAX];
         for (k, v) in line.iter_mut().enumerate().take(N) {
-            *v = self.get(k, j);
+            *v = self.load(k, j);
         }
         line
     }
@@ -122,12 +128,7 @@ impl<const N: usize> Kernels for Cov<N> {
     }
     #[inline(always)]
     fn all_finite(&self) -> bool {
-        // A branch-free OR over the packed entries (it vectorises).
-        let mut bad = false;
-        for v in self.packed() {
-            bad |= !v.is_finite();
-        }
-        !bad
+        super::finite(self.packed())
     }
 }
 
@@ -141,37 +142,13 @@ pub(crate) fn layout_mismatch(have: usize, got: usize) -> CovError {
 }
 
 impl<const N: usize> Cov<N> {
-    /// Column `j` after the shear `z'_i = z_i + s·z_j` (indices as in `raw_shear`).
-    #[inline(always)]
-    fn shear_col(&self, i: usize, j: usize, s: f64) -> [f64; N] {
-        let mut col = [0.0; N];
-        for (k, c) in col.iter_mut().enumerate() {
-            *c = if k == j {
-                quadratic(self.get(j, j) + s * (2.0 * self.get(i, j) + s * self.get(i, i)))
-            } else {
-                self.get(k, j) + s * self.get(k, i)
-            };
-        }
-        col
-    }
-
-    /// Column `i` after scaling axis `i` by `c`.
-    #[inline(always)]
-    fn scale_col(&self, i: usize, c: f64) -> [f64; N] {
-        let mut col = [0.0; N];
-        for (k, v) in col.iter_mut().enumerate() {
-            *v = self.get(k, i) * if k == i { c * c } else { c };
-        }
-        col
-    }
-
     /// `Σ ← Aᵀ Σ A`: `B = Σ A`, then `Σ'_ij = Σ_k A_ki B_kj` for `i ≤ j` only (exact
     /// symmetry).
     fn congruence_in_place(&mut self, a: &Small) {
         let mut b = [[0.0; N]; N];
         for (k, row) in b.iter_mut().enumerate() {
             for (j, v) in row.iter_mut().enumerate() {
-                *v = (0..N).map(|l| self.get(k, l) * a[l][j]).sum();
+                *v = (0..N).map(|l| self.load(k, l) * a[l][j]).sum();
             }
         }
         for i in 0..N {
@@ -187,7 +164,7 @@ impl<const N: usize> Cov<N> {
     fn add_window_in_place(&mut self, p: &[usize], w: &Small) {
         for a in 0..p.len() {
             for b in a..p.len() {
-                let v = self.get(p[a], p[b]) + w[a][b];
+                let v = self.load(p[a], p[b]) + w[a][b];
                 self.set(p[a], p[b], v);
             }
         }
@@ -204,13 +181,13 @@ impl<const N: usize> Cov<N> {
 
     #[inline(always)]
     fn rotate_idx(&mut self, i: usize, j: usize, c: f64, s: f64) {
-        let sii = self.get(i, i);
-        let sij = self.get(i, j);
-        let sjj = self.get(j, j);
+        let sii = self.load(i, i);
+        let sij = self.load(i, j);
+        let sjj = self.load(j, j);
         for k in 0..N {
             if k != i && k != j {
-                let ki = self.get(k, i);
-                let kj = self.get(k, j);
+                let ki = self.load(k, i);
+                let kj = self.load(k, j);
                 self.set(k, i, c * ki + s * kj);
                 self.set(k, j, c * kj - s * ki);
             }
@@ -240,12 +217,12 @@ impl<const N: usize> Cov<N> {
         }
         let mut before = [0.0; N];
         for (i, b) in before.iter_mut().enumerate() {
-            *b = self.get(i, i);
+            *b = self.load(i, i);
         }
         let mut m = [[0.0; MAX]; MAX];
         for a in 0..k {
             for b in 0..k {
-                m[a][b] = s[a][b] + self.get(p[a], p[b]);
+                m[a][b] = s[a][b] + self.load(p[a], p[b]);
             }
         }
         let (minv, _) = psd_pinv(k, &m);
@@ -271,25 +248,25 @@ impl<const N: usize> Cov<N> {
             // g = Σ_{oa,p} M⁺
             let mut g = [0.0; MAX];
             for (c, gc) in g.iter_mut().enumerate().take(k) {
-                *gc = (0..k).map(|d| old.get(oa, p[d]) * minv[d][c]).sum();
+                *gc = (0..k).map(|d| old.load(oa, p[d]) * minv[d][c]).sum();
             }
             for &ob in &others[ai..] {
-                let corr: f64 = (0..k).map(|c| g[c] * old.get(p[c], ob)).sum();
-                self.set(oa, ob, old.get(oa, ob) - corr);
+                let corr: f64 = (0..k).map(|c| g[c] * old.load(p[c], ob)).sum();
+                self.set(oa, ob, old.load(oa, ob) - corr);
             }
         }
         // Σ_op M⁺ S
         for &o in others {
             for b in 0..k {
-                let v: f64 = (0..k).map(|c| old.get(o, p[c]) * t[c][b]).sum();
+                let v: f64 = (0..k).map(|c| old.load(o, p[c]) * t[c][b]).sum();
                 self.set(o, p[b], v);
             }
         }
         // ½ (Σ_pp M⁺ S + S M⁺ Σ_pp): symmetrised, PSD analytically.
         for a in 0..k {
             for b in a..k {
-                let ab: f64 = (0..k).map(|c| old.get(p[a], p[c]) * t[c][b]).sum();
-                let ba: f64 = (0..k).map(|c| old.get(p[b], p[c]) * t[c][a]).sum();
+                let ab: f64 = (0..k).map(|c| old.load(p[a], p[c]) * t[c][b]).sum();
+                let ba: f64 = (0..k).map(|c| old.load(p[b], p[c]) * t[c][a]).sum();
                 self.set(p[a], p[b], 0.5 * (ab + ba));
             }
         }
@@ -305,14 +282,14 @@ impl<const N: usize> Cov<N> {
     fn lobe_product_1(&mut self, p: usize, s: f64) {
         let mut before = [0.0; N];
         for (i, b) in before.iter_mut().enumerate() {
-            *b = self.get(i, i);
+            *b = self.load(i, i);
         }
-        let spp = self.get(p, p);
+        let spp = self.load(p, p);
         let m = s + spp;
         let (inv, t) = if m > 0.0 { (1.0 / m, s / m) } else { (0.0, 0.0) };
         let mut col = [0.0; N];
         for (o, c) in col.iter_mut().enumerate() {
-            *c = self.get(o, p);
+            *c = self.load(o, p);
         }
         for a in 0..N {
             if a == p {
@@ -322,27 +299,32 @@ impl<const N: usize> Cov<N> {
             if ga.is_finite() {
                 for b in a..N {
                     if b != p {
-                        let v = self.get(a, b) - ga * col[b];
+                        let v = self.load(a, b) - ga * col[b];
                         self.set(a, b, v);
                     }
                 }
             } else {
-                // `Σ_ap / m` overflows when `m` is tiny (a denormal `Σ_pp` beside a huge
-                // `Σ_aa`; `1/m` itself may be ∞). The product of the halves
-                // `(Σ_ap/√m)(Σ_bp/√m)` cannot: each is at most `√Σ_aa` for a PSD Σ.
-                let r = 1.0 / m.sqrt();
-                let ha = col[a] * r;
-                for b in a..N {
-                    if b != p {
-                        let v = self.get(a, b) - ha * (col[b] * r);
-                        self.set(a, b, v);
-                    }
-                }
+                self.lobe_row_by_halves(p, a, m, &col);
             }
             self.set(a, p, col[a] * t);
         }
         self.set(p, p, spp * t);
         self.snap_cancelled(&before, &[p]);
+    }
+
+    /// Row `a` of [`Cov::lobe_product_1`] where `Σ_ap / m` overflows: `(Σ_ap/√m)(Σ_bp/√m)`
+    /// cannot (each half ≤ `√Σ_aa`). Out of line: its root and division stay off the hot path.
+    #[cold]
+    #[inline(never)]
+    fn lobe_row_by_halves(&mut self, p: usize, a: usize, m: f64, col: &[f64; N]) {
+        let r = 1.0 / m.sqrt();
+        let ha = col[a] * r;
+        for b in a..N {
+            if b != p {
+                let v = self.load(a, b) - ha * (col[b] * r);
+                self.set(a, b, v);
+            }
+        }
     }
 
     /// Scale-aware clean-up after a Schur complement: a diagonal entry that cancelled to
@@ -360,7 +342,7 @@ impl<const N: usize> Cov<N> {
     #[allow(clippy::eq_op)] // `v − v` is the point: +0, or NaN for a non-finite `v`.
     fn snap_cancelled(&mut self, before: &[f64; N], p: &[usize]) {
         for a in 0..N {
-            let v = self.get(a, a);
+            let v = self.load(a, a);
             // A negative diagonal is never information, on any axis; nor is anything on
             // an axis that had no content before (Σ e_a = 0 gives Σ' e_a = 0: a lobe or an
             // integration cannot create content, only the general lobe's rounding can).
@@ -369,7 +351,7 @@ impl<const N: usize> Cov<N> {
                 // `v − v`: +0 for a finite entry, NaN for ∞ or NaN, so a snap never
                 // hides an overflow (a chain's fast path checks only at the end).
                 for b in 0..N {
-                    let v = self.get(a, b);
+                    let v = self.load(a, b);
                     self.set(a, b, v - v);
                 }
             }

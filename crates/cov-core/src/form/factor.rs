@@ -250,16 +250,20 @@ impl<const N: usize> Kernels for CovFactor<N> {
     const ROTATION_STAYS_FINITE: bool = true;
 
     #[inline(always)]
-    fn k_shear(&mut self, i: usize, j: usize, s: f64) {
+    fn sheared(&self, i: usize, j: usize, s: f64) -> [f64; MAX] {
+        let mut row = [0.0; MAX];
         for c in 0..N {
-            self.l[j][c] += s * self.l[i][c];
+            row[c] = self.l[j][c] + s * self.l[i][c];
         }
+        row
     }
     #[inline(always)]
-    fn k_scale(&mut self, i: usize, c: f64) {
-        for v in self.l[i].iter_mut() {
-            *v *= c;
+    fn scaled(&self, i: usize, c: f64) -> [f64; MAX] {
+        let mut row = [0.0; MAX];
+        for (v, l) in row.iter_mut().zip(&self.l[i]) {
+            *v = l * c;
         }
+        row
     }
     #[inline(always)]
     fn k_rotate(&mut self, i: usize, j: usize, c: f64, s: f64) {
@@ -294,13 +298,7 @@ impl<const N: usize> Kernels for CovFactor<N> {
     }
     #[inline(always)]
     fn all_finite(&self) -> bool {
-        let mut bad = false;
-        for row in &self.l {
-            for v in row {
-                bad |= !v.is_finite();
-            }
-        }
-        !bad
+        super::finite(self.l.as_flattened())
     }
 }
 

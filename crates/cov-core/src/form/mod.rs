@@ -33,8 +33,18 @@ pub(crate) trait Kernels: crate::Spectrum + Copy + Send + Sync + 'static {
     /// of `L` (an orthogonal map keeps their norms, so an entry overflows only within √2
     /// of f64's largest, which a chain's end check and `CovFactor::to_cov` report).
     const ROTATION_STAYS_FINITE: bool;
-    fn k_shear(&mut self, i: usize, j: usize, s: f64);
-    fn k_scale(&mut self, i: usize, c: f64);
+    /// Line `j` ([`Kernels::line`]) after the shear `z'_i = z_i + s·z_j`.
+    fn sheared(&self, i: usize, j: usize, s: f64) -> [f64; MAX];
+    /// Line `i` after scaling axis `i` by `c`.
+    fn scaled(&self, i: usize, c: f64) -> [f64; MAX];
+    #[inline(always)]
+    fn k_shear(&mut self, i: usize, j: usize, s: f64) {
+        self.set_line(j, &self.sheared(i, j, s));
+    }
+    #[inline(always)]
+    fn k_scale(&mut self, i: usize, c: f64) {
+        self.set_line(i, &self.scaled(i, c));
+    }
     fn k_rotate(&mut self, i: usize, j: usize, c: f64, s: f64);
     fn k_add_variance(&mut self, i: usize, w: f64);
     fn k_lobe_1(&mut self, p: usize, s: f64);
@@ -49,33 +59,52 @@ pub(crate) trait Kernels: crate::Spectrum + Copy + Send + Sync + 'static {
     /// Writes back a [`Kernels::line`].
     fn set_line(&mut self, j: usize, line: &[f64; MAX]);
 
-    /// [`Kernels::checked`] for a kernel that wrote line `j` only (`old`, its value
-    /// before): `N` numbers checked instead of all of Σ, and no copy of Σ.
+    /// Writes line `j` if all of `line` is finite (tested in registers, no copy of Σ);
+    /// otherwise reports its first non-finite entry as an overflow of `op`, Σ unchanged.
     #[inline(always)]
-    fn line_checked(&mut self, op: &str, j: usize, old: [f64; MAX]) -> Result<(), crate::CovError> {
-        let mut bad = false;
-        for v in &self.line(j)[..self.dim()] {
-            bad |= !v.is_finite();
-        }
-        if !bad {
+    fn commit_line(&mut self, op: &str, j: usize, line: [f64; MAX]) -> Result<(), crate::CovError> {
+        if finite(&line[..self.dim()]) {
+            self.set_line(j, &line);
             return Ok(());
         }
-        let mut whole = *self;
-        whole.set_line(j, &old);
-        overflowed(self, op, whole)
+        line_overflowed(self, op, j, &line)
     }
 
     /// The end of a checked kernel: `Ok` if every stored number is finite; otherwise Σ is
     /// restored to `old` and the first non-finite entry is reported as an overflow of `op`.
     #[inline(always)]
     fn checked(&mut self, op: &str, old: Self) -> Result<(), crate::CovError> {
-        // The branch-free test first (it vectorises); the search for the entry to report
-        // only on failure.
+        // The branch-free test first; the search for the entry to report only on failure.
         if self.all_finite() {
             return Ok(());
         }
         overflowed(self, op, old)
     }
+}
+
+/// Whether every value is finite: `v · 0` is ±0 for a finite `v`, NaN otherwise, so the OR
+/// of the products' bits less the sign is 0 exactly then (branch-free; it vectorises).
+#[inline(always)]
+pub(crate) fn finite(values: &[f64]) -> bool {
+    let mut bits = 0u64;
+    for v in values {
+        bits |= (v * 0.0).to_bits() << 1;
+    }
+    bits == 0
+}
+
+/// The error of [`Kernels::commit_line`], found with `line` written; Σ is left as it was.
+#[cold]
+#[inline(never)]
+fn line_overflowed<K: Kernels>(
+    k: &mut K,
+    op: &str,
+    j: usize,
+    line: &[f64; MAX],
+) -> Result<(), crate::CovError> {
+    let old = *k;
+    k.set_line(j, line);
+    overflowed(k, op, old)
 }
 
 /// The error of [`Kernels::checked`], with Σ restored to `old`.
@@ -120,15 +149,13 @@ macro_rules! checked_kernels {
         }
         #[inline(always)]
         fn raw_shear(&mut self, op: &str, i: usize, j: usize, s: f64) -> Result<(), CovError> {
-            let old = self.line(j);
-            self.k_shear(i, j, s);
-            self.line_checked(op, j, old)
+            let line = self.sheared(i, j, s);
+            self.commit_line(op, j, line)
         }
         #[inline(always)]
         fn raw_scale(&mut self, op: &str, i: usize, c: f64) -> Result<(), CovError> {
-            let old = self.line(i);
-            self.k_scale(i, c);
-            self.line_checked(op, i, old)
+            let line = self.scaled(i, c);
+            self.commit_line(op, i, line)
         }
         #[inline]
         fn raw_add_window(&mut self, op: &str, p: &[usize], w: &Small) -> Result<(), CovError> {
@@ -161,9 +188,9 @@ macro_rules! checked_kernels {
             if self.get(i, i).is_finite() {
                 return Ok(());
             }
-            let mut line = self.line(i);
-            line[i] = old;
-            self.line_checked(op, i, line)
+            let line = self.line(i);
+            self.set(i, i, old);
+            self.commit_line(op, i, line)
         }
     };
     (@add_variance whole) => {
