@@ -72,9 +72,10 @@ enum Command {
     /// The stiff suite: extreme chains in both forms and plain f64 against a
     /// double-double reference.
     Stiff {
-        /// Length of the long chains.
-        #[arg(long, default_value_t = 10_000)]
-        length: usize,
+        /// Length of the long chains: 4 to 1,000,000 operators, rounded down to whole
+        /// bounces of four.
+        #[arg(long, default_value_t = 10_000, value_parser = clap::value_parser!(u32).range(4..=1_000_000))]
+        length: u32,
     },
 }
 
@@ -229,7 +230,7 @@ fn run(cli: Cli, registry: &Registry) -> Result<(), String> {
             say!("chart written to {output} and {png_name}");
         }
         Command::Stiff { length } => {
-            let cases = cov_stiff::cases(length);
+            let cases = cov_stiff::cases(length as usize);
             let bar = ProgressBar::new(cases.len() as u64);
             let mut outcomes = Vec::with_capacity(cases.len());
             for case in &cases {

@@ -161,3 +161,17 @@ fn the_largest_inputs_run_in_bounded_memory() {
         assert!(t.elapsed().as_secs() < 60, "{cmd}");
     }
 }
+
+/// `stiff --length` is bounded: past it (or past the integers) one line and exit 2, no
+/// allocation attempted (it used to abort on a 32 GB request or panic on a capacity
+/// overflow).
+#[test]
+fn the_stiff_length_is_bounded() {
+    for length in ["1000001", "18446744073709551615", "0"] {
+        let o = covtrace(&["stiff", "--length", length]);
+        assert_eq!(o.status.code(), Some(2), "{length}");
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert!(err.contains("--length"), "{err}");
+        assert_eq!(err.trim_end().lines().count(), 1, "{err}");
+    }
+}

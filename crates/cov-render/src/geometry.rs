@@ -104,7 +104,26 @@ fn v3a(v: DVec3) -> Vec3A {
     Vec3A::new(v.x as f32, v.y as f32, v.z as f32)
 }
 
+/// Largest distance (m) from the origin that a primitive may reach over the shutter: the
+/// BVH is built and traversed in single precision, and its boxes' areas, up to
+/// `(2 · MAX_COORD)² = 4e24` m², must stay finite there (3.4e38); a box past that range
+/// breaks the build. Checked where the scene is read and for each frame of an animation.
+pub const MAX_COORD: f64 = 1e12;
+
 impl Prim {
+    /// The largest |coordinate| the primitive reaches over the times `t0..t1` (∞ or NaN
+    /// where its motion overflows).
+    pub fn reach(&self, t0: f64, t1: f64) -> f64 {
+        let (a0, b0) = self.bounds_at(t0);
+        let (a1, b1) = self.bounds_at(t1);
+        let m = a0.abs().max(b0.abs()).max(a1.abs()).max(b1.abs());
+        if m.is_finite() {
+            m.max_element()
+        } else {
+            f64::INFINITY
+        }
+    }
+
     fn bounds_at(&self, t: f64) -> (DVec3, DVec3) {
         let off = self.velocity * t;
         match self.shape {
@@ -241,6 +260,11 @@ impl Geometry {
     /// The same primitives under a BVH for the times `t0..t1` (an animation's frame).
     pub fn retimed(&self, t0: f64, t1: f64) -> Geometry {
         Geometry::new(self.prims.clone(), t0, t1)
+    }
+
+    /// The largest |coordinate| any primitive reaches over the times `t0..t1`.
+    pub fn reach(&self, t0: f64, t1: f64) -> f64 {
+        self.prims.iter().map(|p| p.reach(t0, t1)).fold(0.0, f64::max)
     }
 
     /// Number of primitives.

@@ -32,6 +32,17 @@ pub fn tonemap(img: &Image) -> image::RgbImage {
     })
 }
 
+/// `v` in single precision, as an EXR stores it: never ±∞ (a value past f32's range is
+/// clamped to its largest; scene colours are bounded so that a render does not get there,
+/// `scene::MAX_COLOUR`) and never NaN (0).
+fn single(v: f64) -> f32 {
+    if v.is_nan() {
+        0.0
+    } else {
+        v.clamp(-f64::from(f32::MAX), f64::from(f32::MAX)) as f32
+    }
+}
+
 /// Writes `img` as linear OpenEXR (`.exr`) and a tone-mapped sRGB PNG beside it.
 ///
 /// # Errors
@@ -40,7 +51,7 @@ pub fn write_image(img: &Image, exr: &Path, png: &Path) -> Result<(), RenderErro
     let raw: Vec<f32> = img
         .pixels
         .iter()
-        .flat_map(|p| [p.x as f32, p.y as f32, p.z as f32])
+        .flat_map(|p| [p.x, p.y, p.z].map(single))
         .collect();
     let hdr = image::Rgb32FImage::from_raw(img.width, img.height, raw)
         .ok_or_else(|| RenderError::file(exr, "the image's pixels do not match its size"))?;
@@ -163,7 +174,7 @@ pub fn write_aovs(aovs: &Aovs, path: &Path) -> Result<(), RenderError> {
     let (w, h) = (aovs.albedo.width as usize, aovs.albedo.height as usize);
     fn at(img: &crate::film::Image, p: exr::math::Vec2<usize>) -> (f32, f32, f32) {
         let v = img.pixels[p.y() * img.width as usize + p.x()];
-        (v.x as f32, v.y as f32, v.z as f32)
+        (single(v.x), single(v.y), single(v.z))
     }
     let layer = |name: &str| (LayerAttributes::named(name), Encoding::FAST_LOSSLESS);
     let (na, ea) = layer("albedo");
@@ -176,7 +187,7 @@ pub fn write_aovs(aovs: &Aovs, path: &Path) -> Result<(), RenderError> {
         Encoding::FAST_LOSSLESS,
         SpecificChannels::build()
             .with_channel("Z")
-            .with_pixel_fn(|p: Vec2<usize>| (aovs.depth[p.y() * w + p.x()] as f32,)),
+            .with_pixel_fn(|p: Vec2<usize>| (single(aovs.depth[p.y() * w + p.x()]),)),
     );
     Image::empty(ImageAttributes::new(IntegerBounds::from_dimensions((w, h))))
         .with_layer(albedo)
@@ -185,4 +196,16 @@ pub fn write_aovs(aovs: &Aovs, path: &Path) -> Result<(), RenderError> {
         .write()
         .to_file(path)
         .map_err(|e| RenderError::file(path, e))
+}
+
+#[cfg(test)]
+mod tests {
+    /// What the EXR stores is finite: past f32's range clamped to its largest, NaN as 0.
+    #[test]
+    fn single_precision_output_is_finite() {
+        assert_eq!(super::single(1.5), 1.5);
+        assert_eq!(super::single(1e300), f32::MAX);
+        assert_eq!(super::single(f64::NEG_INFINITY), -f32::MAX);
+        assert_eq!(super::single(f64::NAN), 0.0);
+    }
 }

@@ -34,6 +34,8 @@
 //! | `materials` | | named `Diffuse(albedo)`, `Phong(albedo, exponent)`, `Ggx(albedo, alpha)`, each with an optional `texture` that multiplies the albedo |
 //! | `lights` | | `Rect(corner, edge_u, edge_v, radiance)`, `Sphere(center, radius, radiance)`; radiance in W/(m² sr) per channel |
 //! | `shapes` | | `Sphere(center, radius, material, velocity)`, `Quad(corner, edge_u, edge_v, material, velocity)`, `Mesh(obj, material, translate, scale, velocity)` |
+//! | colours (`albedo`, texture colours, `radiance`) | | each entry 0 to [`MAX_COLOUR`] (1e9) |
+//! | every shape and light | m | within ±[`crate::geometry::MAX_COORD`] (1e12) of the origin, with its motion over the shutter (and at every frame rendered) |
 
 use std::collections::BTreeMap;
 
@@ -99,11 +101,18 @@ fn triple<'de, D: Deserializer<'de>>(
     if [a, b, c].into_iter().all(ok) {
         Ok([a, b, c])
     } else {
+        let [a, b, c] = [a, b, c].map(cov_core::num);
         Err(D::Error::custom(format!("{what}, got ({a}, {b}, {c})")))
     }
 }
 
-/// A colour `(r, g, b)`, finite and ≥ 0.
+/// Largest entry of a colour (an albedo, a texture's colour, a light's radiance in
+/// W·sr⁻¹·m⁻², the sun's being about 2e7): a pixel is a product of at most four of them
+/// (a light, two reflections, a texture), and `MAX_COLOUR⁴ = 1e36` stays below the
+/// largest single-precision number (3.4e38), which the EXR stores.
+pub const MAX_COLOUR: f64 = 1e9;
+
+/// A colour `(r, g, b)`, each entry finite, ≥ 0 and at most [`MAX_COLOUR`].
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Rgb(pub [f64; 3]);
 
@@ -111,8 +120,8 @@ impl<'de> Deserialize<'de> for Rgb {
     fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
         triple(
             d,
-            |x| x.is_finite() && x >= 0.0,
-            "a colour must be finite and ≥ 0",
+            |x| (0.0..=MAX_COLOUR).contains(&x),
+            "a colour must be finite, ≥ 0 and ≤ 1e9",
         )
         .map(Rgb)
     }

@@ -6,7 +6,7 @@ use std::path::Path;
 
 use glam::{DVec2, DVec3};
 
-use crate::geometry::{Geometry, Hit, Prim, Shape};
+use crate::geometry::{Geometry, Hit, MAX_COORD, Prim, Shape};
 use crate::material::{Material, basis};
 use crate::scene::{
     At, CameraDesc, LightDesc, MAX_SCENE_BYTES, MAX_TRIANGLES, MaterialDesc, Rgb, SceneError, SceneFile,
@@ -332,7 +332,18 @@ impl World {
         let c = &mut self.camera;
         c.time_offset = f64::from(frame) / c.frame_rate;
         let (t0, t1) = c.shutter.unwrap_or((0.0, 0.0));
-        self.geometry = self.geometry.retimed(t0 + c.time_offset, t1 + c.time_offset);
+        let (t0, t1) = (t0 + c.time_offset, t1 + c.time_offset);
+        let reach = self.geometry.reach(t0, t1);
+        if reach > MAX_COORD {
+            return Err(crate::RenderError::setting(
+                "frame",
+                format!(
+                    "a frame at which every shape stays within ±{MAX_COORD:e} m (this one moves one to {reach:e} m)"
+                ),
+                frame,
+            ));
+        }
+        self.geometry = self.geometry.retimed(t0, t1);
         self.frame = frame;
         Ok(self)
     }
@@ -407,11 +418,12 @@ impl World {
         let (materials, material_names, material_textures) =
             materials(&desc, &Names(&texture_names, "texture")).map_err(|(o, m)| at(o, m))?;
         let mut prims = Vec::new();
-        let lights = lights(&desc, &mut prims).map_err(|(o, m)| at(o, m))?;
-        let names = Names(&material_names, "material");
-        let any_velocity = shapes(&desc, &names, dir, &mut prims).map_err(|(o, m)| at(o, m))?
-            || camera.velocity != DVec3::ZERO;
         let (t0, t1) = camera.shutter.unwrap_or((0.0, 0.0));
+        let lights = lights(&desc, &mut prims).map_err(|(o, m)| at(o, m))?;
+        within_reach(&prims, 0, t0, t1, desc.lights.ordinal).map_err(|(o, m)| at(o, m))?;
+        let names = Names(&material_names, "material");
+        let any_velocity = shapes(&desc, &names, dir, &mut prims, (t0, t1)).map_err(|(o, m)| at(o, m))?
+            || camera.velocity != DVec3::ZERO;
         Ok(World {
             file: file.to_string(),
             fingerprint: fingerprint(text, &input_files(&desc, dir)),
@@ -758,11 +770,34 @@ fn lights(desc: &SceneFile, prims: &mut Vec<Prim>) -> Result<Vec<Light>, Failure
     Ok(lights)
 }
 
-/// The shapes, added to `prims`; whether any of them moves.
-fn shapes(desc: &SceneFile, names: &Names<'_>, dir: &Path, prims: &mut Vec<Prim>) -> Result<bool, Failure> {
+/// `Err` at `ordinal` if a primitive of `prims[from..]` reaches past [`MAX_COORD`] over
+/// the shutter `t0..t1`.
+fn within_reach(prims: &[Prim], from: usize, t0: f64, t1: f64, ordinal: u32) -> Result<(), Failure> {
+    let reach = prims[from..].iter().map(|p| p.reach(t0, t1)).fold(0.0, f64::max);
+    if reach <= MAX_COORD {
+        return Ok(());
+    }
+    Err((
+        ordinal,
+        format!(
+            "this shape reaches {reach:e} m from the origin (over the shutter, if it moves): the renderer's single-precision BVH holds ±{MAX_COORD:e} m"
+        ),
+    ))
+}
+
+/// The shapes, added to `prims`; whether any of them moves. Each must stay within
+/// [`MAX_COORD`] over the shutter `(t0, t1)`.
+fn shapes(
+    desc: &SceneFile,
+    names: &Names<'_>,
+    dir: &Path,
+    prims: &mut Vec<Prim>,
+    (t0, t1): (f64, f64),
+) -> Result<bool, Failure> {
     let mut triangles = 0usize;
     let mut any_velocity = false;
     for s in &desc.shapes {
+        let from = prims.len();
         let (material, velocity) = match s {
             ShapeDesc::Sphere {
                 material, velocity, ..
@@ -825,6 +860,11 @@ fn shapes(desc: &SceneFile, names: &Names<'_>, dir: &Path, prims: &mut Vec<Prim>
                 }
             }
         }
+        let ordinal = match s {
+            ShapeDesc::Mesh { obj, .. } => obj.ordinal,
+            ShapeDesc::Sphere { material, .. } | ShapeDesc::Quad { material, .. } => material.ordinal,
+        };
+        within_reach(prims, from, t0, t1, ordinal)?;
     }
     Ok(any_velocity)
 }

@@ -188,3 +188,58 @@ fn refused_values_name_their_field() {
     let fov = scene(&[("FOV", "-1.0")]);
     assert!(error(&fov).contains("`fov`"), "{}", error(&fov));
 }
+
+/// What single precision cannot hold is refused where it is written: a shape or a light
+/// past `MAX_COORD` (at rest or by its motion over the shutter), a colour past
+/// `MAX_COLOUR` (printed compactly); and a frame that moves a shape past it is an error,
+/// not a broken BVH.
+#[test]
+fn what_single_precision_cannot_hold_is_refused() {
+    let far = scene(&[(
+        "SHAPE",
+        r#"Sphere(center: (2e12, 0.5, 0.0), radius: 0.5, material: "w")"#,
+    )]);
+    let e = error(&far);
+    assert!(
+        e.starts_with("5:131: this shape reaches 2.0000000000005e12 m"),
+        "{e}"
+    );
+    let light = scene(&[(
+        "LIGHTS",
+        "[Sphere(center: (0.0, 2.0, -5e12), radius: 0.2, radiance: (1.0, 1.0, 1.0))]",
+    )]);
+    assert!(
+        error(&light).starts_with("4:13: this shape reaches 5.0000000000002e12 m"),
+        "{}",
+        error(&light)
+    );
+    let fast = scene(&[
+        ("LENS", ", shutter: (open: 0.0, close: 0.5)"),
+        (
+            "SHAPE",
+            r#"Sphere(center: (0.0, 0.5, 0.0), radius: 0.5, material: "w", velocity: (0.0, 1e300, 0.0))"#,
+        ),
+    ]);
+    assert!(error(&fast).contains("reaches 5e299 m"), "{}", error(&fast));
+    let hot = scene(&[(
+        "LIGHTS",
+        "[Sphere(center: (0.0, 2.0, 0.0), radius: 0.2, radiance: (1e300, 1.0, 1.0))]",
+    )]);
+    assert!(
+        error(&hot).contains("`radiance`: a colour must be finite, ≥ 0 and ≤ 1e9, got (1e300, 1, 1)"),
+        "{}",
+        error(&hot)
+    );
+    // At rest within reach, moving out of it by frame 1000 (at 24 frames per second).
+    let drifting = scene(&[
+        ("LENS", ", shutter: (open: 0.0, close: 0.01)"),
+        (
+            "SHAPE",
+            r#"Sphere(center: (0.0, 0.5, 0.0), radius: 0.5, material: "w", velocity: (1e11, 0.0, 0.0))"#,
+        ),
+    ]);
+    let world = || World::from_text(&drifting, "s.ron", Path::new(".")).expect("within reach at frame 0");
+    assert!(world().at_frame(1).is_ok());
+    let e = world().at_frame(1000).unwrap_err().to_string();
+    assert!(e.contains("every shape stays within ±1e12 m"), "{e}");
+}
