@@ -150,16 +150,43 @@ impl<'de> Deserialize<'de> for Resolution {
 pub struct SceneFile {
     /// The camera.
     pub camera: CameraDesc,
-    /// Named textures (materials refer to them by name).
-    #[serde(default)]
+    /// Named textures (materials refer to them by name), each name once.
+    #[serde(default, deserialize_with = "unique_names")]
     pub textures: BTreeMap<At<String>, At<TextureDesc>>,
-    /// Named materials.
-    #[serde(default)]
+    /// Named materials, each name once.
+    #[serde(default, deserialize_with = "unique_names")]
     pub materials: BTreeMap<At<String>, MaterialDesc>,
     /// Emitters.
     pub lights: At<Vec<LightDesc>>,
     /// Geometry.
     pub shapes: Vec<ShapeDesc>,
+}
+
+/// A map of names to definitions in which a name given twice is an error (where the
+/// second definition ends), not a silent replacement of the first.
+fn unique_names<'de, D, V>(d: D) -> Result<BTreeMap<At<String>, V>, D::Error>
+where
+    D: Deserializer<'de>,
+    V: Deserialize<'de>,
+{
+    struct Names<V>(std::marker::PhantomData<V>);
+    impl<'de, V: Deserialize<'de>> serde::de::Visitor<'de> for Names<V> {
+        type Value = BTreeMap<At<String>, V>;
+        fn expecting(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+            f.write_str("a map of names to definitions")
+        }
+        fn visit_map<A: serde::de::MapAccess<'de>>(self, mut map: A) -> Result<Self::Value, A::Error> {
+            let mut out = BTreeMap::new();
+            while let Some((name, value)) = map.next_entry::<At<String>, V>()? {
+                let echo = crate::echo(&name.value);
+                if out.insert(name, value).is_some() {
+                    return Err(A::Error::custom(format!("`{echo}` is defined twice")));
+                }
+            }
+            Ok(out)
+        }
+    }
+    d.deserialize_map(Names(std::marker::PhantomData))
 }
 
 /// The camera.

@@ -18,6 +18,12 @@ fn scene(parts: &[(&str, &str)]) -> String {
     for (k, v) in parts {
         t = t.replace(k, v);
     }
+    scene_from(&t)
+}
+
+/// `text` (a [`BASE`] with some placeholders replaced) with defaults for the others.
+fn scene_from(text: &str) -> String {
+    let mut t = text.to_string();
     for (k, v) in [
         ("LOOK", "(0.0, 1.0, 0.0)"),
         ("FOV", "40.0"),
@@ -242,4 +248,19 @@ fn what_single_precision_cannot_hold_is_refused() {
     assert!(world().at_frame(1).is_ok());
     let e = world().at_frame(1000).unwrap_err().to_string();
     assert!(e.contains("every shape stays within ±1e12 m"), "{e}");
+}
+
+/// A material or texture name given twice is an error where the second definition is,
+/// not a silent replacement of the first.
+#[test]
+fn a_name_defined_twice_is_refused() {
+    let twice = scene(&[("MAT", r#""w": Diffuse(albedo: (0.9, 0.1, 0.1))"#)]);
+    let e = error(&twice);
+    assert!(e.starts_with("3:94: `w` is defined twice"), "{e}");
+    let textures = BASE.replace(
+        "    materials:",
+        "    textures: { \"t\": Checker(checks: (2, 2), a: (1.0, 1.0, 1.0), b: (0.0, 0.0, 0.0)), \"t\": Stripes(count: 2, duty: 0.5, a: (1.0, 1.0, 1.0), b: (0.0, 0.0, 0.0)) },\n    materials:",
+    );
+    let e = error(&scene_from(&textures));
+    assert!(e.contains("`t` is defined twice"), "{e}");
 }
