@@ -280,13 +280,6 @@ pub fn bench(a: &BenchArgs) -> Result<String, String> {
         "scene: {} ({w}×{h} px)\n",
         cov_render::echo(&a.scene.display().to_string())
     );
-    let (reference, line) = reference(a, &world, &text, &cache)?;
-    out.push_str(&line);
-    out.push('\n');
-    tonemap(&reference)
-        .save(a.output.join("reference.png"))
-        .map_err(|e| format!("{}: {e}", a.output.join("reference.png").display()))?;
-
     let settings = |Variant(method, denoise): Variant, spp: f64, seed: u64| RenderSettings {
         method,
         spp,
@@ -298,6 +291,16 @@ pub fn bench(a: &BenchArgs) -> Result<String, String> {
         parts: a.parts,
         ..RenderSettings::default()
     };
+    // The runs' settings checked against the scene (`--parts` against its rows) before
+    // the reference, which may take minutes.
+    Renderer::new(&world, settings(Variant::UNIFORM, budgets[0], 1)).map_err(|e| e.to_string())?;
+    let (reference, line) = reference(a, &world, &text, &cache)?;
+    out.push_str(&line);
+    out.push('\n');
+    tonemap(&reference)
+        .save(a.output.join("reference.png"))
+        .map_err(|e| format!("{}: {e}", a.output.join("reference.png").display()))?;
+
     // Every run goes through the library's renderer, with a covariance guide traced here
     // (its time is added to every covariance run that reads it: not to `cov` followed by a
     // denoiser below 3 spp, which has no pilot, `cov_render::renderer::reads_covariance`).

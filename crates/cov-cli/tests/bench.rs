@@ -91,3 +91,32 @@ fn bad_arguments_give_one_line() {
         );
     }
 }
+
+/// `--parts` is checked against the scene's rows before the reference is rendered (it
+/// used to fail only after the reference, minutes in at the default `--ref-spp`).
+#[test]
+fn parts_are_checked_before_the_reference() {
+    let dir = common::tmp("bench", "parts");
+    let d = dir.to_str().expect("utf-8 path");
+    let out = covtrace(&[
+        "render-bench",
+        "examples/scenes/cornell.ron",
+        "--size",
+        "32x24",
+        "--ref-spp",
+        "64",
+        "--parts",
+        "100",
+        "-o",
+        d,
+        "--cache",
+        d,
+    ]);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{stderr}");
+    assert!(stderr.contains("parts must be 1 to 2"), "{stderr}");
+    assert!(
+        !dir.join("reference.png").exists(),
+        "a reference was rendered first"
+    );
+}
