@@ -94,3 +94,14 @@ impl RenderError {
         }
     }
 }
+
+/// `Ok` if `path` is a regular file (or a link to one); otherwise what it is instead, in
+/// one line: missing, or there but not a file (a directory, a device such as `/dev/zero`).
+pub(crate) fn regular_file(path: &std::path::Path) -> Result<(), String> {
+    let shown = || cov_core::one_line(&path.display().to_string());
+    match std::fs::metadata(path) {
+        Ok(m) if m.is_file() => Ok(()),
+        Ok(_) => Err(format!("not a regular file: {}", shown())),
+        Err(_) => Err(format!("no such file: {}", shown())),
+    }
+}

@@ -188,9 +188,7 @@ impl TextureMap {
     /// An unreadable or undecodable file, or an image larger than [`MAX_TEXTURE_SIDE`].
     pub fn load(path: &Path, repeat: DVec2) -> Result<TextureMap, String> {
         let one = |e: &dyn std::fmt::Display| cov_core::one_line(&e.to_string());
-        if !path.is_file() {
-            return Err(format!("no such file: {}", one(&path.display())));
-        }
+        crate::error::regular_file(path)?;
         // By content, then by extension; anything but PNG and EXR is named as such.
         let open = || {
             let r = image::ImageReader::open(path)

@@ -885,12 +885,7 @@ type ObjTriangle = ([DVec3; 3], Option<[DVec3; 3]>, Option<[DVec2; 3]>);
 /// Triangles (with vertex normals and texture coordinates when the file has them) of an
 /// OBJ file, at most `limit`.
 fn load_obj(path: &Path, limit: usize) -> Result<Vec<ObjTriangle>, String> {
-    if !path.is_file() {
-        return Err(format!(
-            "no such file: {}",
-            cov_core::one_line(&path.display().to_string())
-        ));
-    }
+    crate::error::regular_file(path)?;
     let opts = tobj::LoadOptions {
         triangulate: true,
         single_index: true,

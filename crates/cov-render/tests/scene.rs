@@ -264,3 +264,19 @@ fn a_name_defined_twice_is_refused() {
     let e = error(&scene_from(&textures));
     assert!(e.contains("`t` is defined twice"), "{e}");
 }
+
+/// A texture or mesh path that is there but not a file (a directory) says so, rather
+/// than that there is no such file.
+#[test]
+fn a_path_that_is_not_a_file_says_so() {
+    let dir = BASE.replace(
+        "    materials:",
+        "    textures: { \"t\": Image(file: \".\") },\n    materials:",
+    );
+    let e = error(&scene_from(&dir));
+    assert!(e.contains("texture `t`: not a regular file: ./."), "{e}");
+    let mesh = scene(&[("SHAPE", r#"Mesh(obj: ".", material: "w")"#)]);
+    assert!(error(&mesh).contains("not a regular file"), "{}", error(&mesh));
+    let missing = scene(&[("SHAPE", r#"Mesh(obj: "missing.obj", material: "w")"#)]);
+    assert!(error(&missing).contains("no such file"), "{}", error(&missing));
+}
