@@ -116,12 +116,11 @@ fn overflowed<K: Kernels>(k: &mut K, op: &str, old: K) -> Result<(), crate::CovE
     Err(crate::CovError::overflow(op, at))
 }
 
-/// The checked raw kernels of [`crate::Spectrum`] for a form, each derived from the
-/// form's unchecked kernel ([`Kernels`]): the kernel runs in place, then
-/// [`Kernels::checked`] (or [`Kernels::line_checked`] for a kernel that wrote one line)
-/// restores what it wrote and reports if the result overflowed. So each rule's
-/// arithmetic is written once per form, and the checked and unchecked paths give the same
-/// bits.
+/// The checked raw kernels of [`crate::Spectrum`] for a form, each from the form's
+/// unchecked kernel ([`Kernels`]): it runs in place and [`Kernels::checked`] restores Σ and
+/// reports if the result overflowed; a one-line kernel's line is computed first and written
+/// only if finite ([`Kernels::commit_line`]). So each rule's arithmetic is written once per
+/// form, and the checked and unchecked paths give the same bits.
 macro_rules! checked_kernels {
     ($add_variance:ident) => {
         $crate::form::checked_kernels!(@add_variance $add_variance);
