@@ -85,7 +85,7 @@ pub struct BenchArgs {
     /// does (`covtrace render --parts N`): what splitting costs in error.
     #[arg(long, default_value_t = 1)]
     pub parts: u32,
-    /// Output folder (created if missing; its parent must exist).
+    /// Output folder (created with its missing parents).
     #[arg(short, long, default_value = "render-bench")]
     pub output: PathBuf,
     /// Folder of cached references (default: the output folder).
