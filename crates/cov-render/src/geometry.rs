@@ -100,6 +100,11 @@ impl std::fmt::Debug for Geometry {
     }
 }
 
+/// The largest |coordinate| any of `prims` reaches over the times `t0..t1` ([`Prim::reach`]).
+pub fn reach(prims: &[Prim], t0: f64, t1: f64) -> f64 {
+    prims.iter().map(|p| p.reach(t0, t1)).fold(0.0, f64::max)
+}
+
 fn v3a(v: DVec3) -> Vec3A {
     Vec3A::new(v.x as f32, v.y as f32, v.z as f32)
 }
@@ -111,8 +116,8 @@ fn v3a(v: DVec3) -> Vec3A {
 pub const MAX_COORD: f64 = 1e12;
 
 impl Prim {
-    /// The largest |coordinate| the primitive reaches over the times `t0..t1` (∞ or NaN
-    /// where its motion overflows).
+    /// The largest |coordinate| the primitive reaches over the times `t0..t1` (∞ where its
+    /// motion overflows).
     pub fn reach(&self, t0: f64, t1: f64) -> f64 {
         let (a0, b0) = self.bounds_at(t0);
         let (a1, b1) = self.bounds_at(t1);
@@ -264,7 +269,7 @@ impl Geometry {
 
     /// The largest |coordinate| any primitive reaches over the times `t0..t1`.
     pub fn reach(&self, t0: f64, t1: f64) -> f64 {
-        self.prims.iter().map(|p| p.reach(t0, t1)).fold(0.0, f64::max)
+        reach(&self.prims, t0, t1)
     }
 
     /// Number of primitives.

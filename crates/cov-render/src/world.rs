@@ -773,7 +773,7 @@ fn lights(desc: &SceneFile, prims: &mut Vec<Prim>) -> Result<Vec<Light>, Failure
 /// `Err` at `ordinal` if a primitive of `prims[from..]` reaches past [`MAX_COORD`] over
 /// the shutter `t0..t1`.
 fn within_reach(prims: &[Prim], from: usize, t0: f64, t1: f64, ordinal: u32) -> Result<(), Failure> {
-    let reach = prims[from..].iter().map(|p| p.reach(t0, t1)).fold(0.0, f64::max);
+    let reach = crate::geometry::reach(&prims[from..], t0, t1);
     if reach <= MAX_COORD {
         return Ok(());
     }
