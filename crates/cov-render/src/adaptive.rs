@@ -353,11 +353,12 @@ impl Guide {
 /// Per pixel of `rows` (0 elsewhere), the relative standard deviation of a sample,
 /// `√(σ² / (μ² + ε))`, blurred over 3×3 pixels (a pilot's variances are noisy).
 pub(crate) fn relative_variance(film: &Film, rows: Range<u32>) -> Vec<f64> {
+    use rayon::prelude::*;
     let (w, h) = (film.width as i64, film.height as i64);
     let var = film.variance();
     let box_img = film.box_image();
     let raw: Vec<f64> = var
-        .iter()
+        .par_iter()
         .zip(&box_img.pixels)
         .map(|(&v, p)| {
             let m = luminance(*p);
@@ -365,6 +366,7 @@ pub(crate) fn relative_variance(film: &Film, rows: Range<u32>) -> Vec<f64> {
         })
         .collect();
     (0..w * h)
+        .into_par_iter()
         .map(|i| {
             if !rows.contains(&((i / w) as u32)) {
                 return 0.0;

@@ -444,35 +444,34 @@ pub struct Aovs {
 /// pixel's new [`Film::lum_top`].
 type TileOut = Vec<(DVec3, DVec3, u32, [f64; 2], (DVec3, DVec3, f64), f64)>;
 
-/// Sums of `v` over windows of `2r + 1` values along one axis of an image: `n` lines of
-/// `len` values, value `k` of line `l` at `l · line + k · step` (rows: `line = width`,
-/// `step = 1`; columns the other way round). The window is clipped at the ends.
-fn box_sums(v: &[[f64; 2]], len: usize, n: usize, r: usize, step: usize, line: usize) -> Vec<[f64; 2]> {
-    // Each line's sums (lines in parallel), then put in place.
-    let lines: Vec<Vec<[f64; 2]>> = (0..n)
-        .into_par_iter()
-        .map(|l| {
-            let at = |k: usize| l * line + k * step;
-            // Each window's sum from scratch (2r + 1 terms a value): no running difference,
-            // whose rounding would leave a residue where a window holds only zeros.
-            (0..len)
-                .map(|k| {
-                    let mut s = [0.0; 2];
-                    for q in k.saturating_sub(r)..(k + r + 1).min(len) {
-                        s[0] += v[at(q)][0];
-                        s[1] += v[at(q)][1];
-                    }
-                    s
-                })
-                .collect()
-        })
-        .collect();
-    let mut out = vec![[0.0; 2]; v.len()];
-    for (l, sums) in lines.into_iter().enumerate() {
-        for (k, s) in sums.into_iter().enumerate() {
-            out[l * line + k * step] = s;
+/// Sums of `v` (an image of `w` columns, row by row) over the `(2r + 1)²` pixels around
+/// each pixel, clipped at the borders: a pass along the rows, then one along the columns.
+/// Each window's sum is taken from scratch (`2r + 1` terms a value, in order), not as a
+/// running difference, whose rounding would leave a residue where a window holds only
+/// zeros. The column pass adds whole rows in that order, so it reads memory row by row,
+/// and both passes run a row of output per task.
+fn box_sums(v: &[[f64; 2]], w: usize, r: usize) -> Vec<[f64; 2]> {
+    let w = w.max(1);
+    let h = v.len() / w;
+    let mut rows = vec![[0.0; 2]; v.len()];
+    rows.par_chunks_mut(w).enumerate().for_each(|(y, out)| {
+        let line = &v[y * w..(y + 1) * w];
+        for (k, o) in out.iter_mut().enumerate() {
+            for q in &line[k.saturating_sub(r)..(k + r + 1).min(w)] {
+                o[0] += q[0];
+                o[1] += q[1];
+            }
         }
-    }
+    });
+    let mut out = vec![[0.0; 2]; v.len()];
+    out.par_chunks_mut(w).enumerate().for_each(|(y, out)| {
+        for q in y.saturating_sub(r)..(y + r + 1).min(h) {
+            for (o, a) in out.iter_mut().zip(&rows[q * w..(q + 1) * w]) {
+                o[0] += a[0];
+                o[1] += a[1];
+            }
+        }
+    });
     out
 }
 
@@ -525,6 +524,7 @@ impl Film {
     /// The box estimate: each pixel's mean of its own samples (black where it has none).
     pub fn box_image(&self) -> Image {
         let pixels = (0..self.count.len())
+            .into_par_iter()
             .map(|i| match self.count[i] {
                 0 => DVec3::ZERO,
                 n => (self.emitted[i] + self.reflected[i]) / f64::from(n),
@@ -697,15 +697,16 @@ impl Film {
     /// split, at most 1 (a scrambled net is not taken to be worse than Monte Carlo).
     pub fn variance_of_mean(&self) -> Vec<f64> {
         const R: usize = SPLIT_REACH;
-        let (w, h) = (self.width as usize, self.height as usize);
         let var = self.variance();
         let mc: Vec<f64> = (0..self.count.len())
+            .into_par_iter()
             .map(|i| var[i] / f64::from(self.count[i].max(1)))
             .collect();
         // The split estimate where the count is a power of two of at least 2:
         // (m₁ − m₂)²/4 = ((S − T) − T)² / n², `S` the sum and `T` the second half's; and
         // the Monte Carlo estimate of the same pixels.
         let pairs: Vec<[f64; 2]> = (0..self.count.len())
+            .into_par_iter()
             .map(|i| {
                 let n = self.count[i];
                 if n >= 2 && n.is_power_of_two() {
@@ -717,9 +718,9 @@ impl Film {
             })
             .collect();
         // Their sums over the (2R + 1)² pixels around, a row pass then a column pass.
-        let rows = box_sums(&pairs, w, h, R, 1, w);
-        let sums = box_sums(&rows, h, w, R, w, 1);
+        let sums = box_sums(&pairs, self.width as usize, R);
         (0..self.count.len())
+            .into_par_iter()
             .map(|i| {
                 let [a, b] = sums[i];
                 // No split around, or no variance to scale: Monte Carlo's estimate.
@@ -851,6 +852,45 @@ impl Film {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// `box_sums` is the clipped window sum of its definition (to rounding), and a window
+    /// of zeros sums to exactly 0 however large the values beside it.
+    #[test]
+    fn box_sums_are_clipped_window_sums() {
+        use rand::{Rng, SeedableRng};
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(5);
+        for (w, h, r) in [(13usize, 7usize, 2usize), (5, 11, 4), (1, 9, 4), (9, 1, 1)] {
+            let v: Vec<[f64; 2]> = (0..w * h)
+                .map(|_| [rng.random_range(0.0..1.0), rng.random_range(-1.0..1.0)])
+                .collect();
+            let got = box_sums(&v, w, r);
+            for y in 0..h {
+                for x in 0..w {
+                    let mut want = [0.0; 2];
+                    for yy in y.saturating_sub(r)..(y + r + 1).min(h) {
+                        for xx in x.saturating_sub(r)..(x + r + 1).min(w) {
+                            want[0] += v[yy * w + xx][0];
+                            want[1] += v[yy * w + xx][1];
+                        }
+                    }
+                    for k in 0..2 {
+                        assert!((got[y * w + x][k] - want[k]).abs() <= 1e-12, "({x}, {y}) {k}");
+                    }
+                }
+            }
+        }
+        // Huge values beside a block of zeros: the zeros' windows stay exactly 0.
+        let (w, h) = (20, 3);
+        let v: Vec<[f64; 2]> = (0..w * h)
+            .map(|i| if i % w < 5 { [1e300, 3e17] } else { [0.0; 2] })
+            .collect();
+        let got = box_sums(&v, w, 4);
+        for y in 0..h {
+            for x in 9..w {
+                assert_eq!(got[y * w + x], [0.0; 2], "({x}, {y})");
+            }
+        }
+    }
 
     #[test]
     fn gaussians_are_normalised_and_clamped() {
