@@ -481,13 +481,27 @@ pub fn merge(a: &MergeArgs) -> Result<String, String> {
             a.parts.len()
         ));
     }
+    let [png, density, filter, json, aov] = outputs(&a.output);
+    // A merge must not overwrite the parts it reads: a part lost is a job to run again.
+    let same = |x: &Path, y: &Path| match (x.canonicalize(), y.canonicalize()) {
+        (Ok(x), Ok(y)) => x == y,
+        _ => false,
+    };
+    for out in [&a.output, &png, &density, &filter, &json, &aov] {
+        if let Some(p) = a.parts.iter().find(|p| same(p, out)) {
+            return Err(format!(
+                "{}: this part file is also an output of the merge (-o {}), which would overwrite it; give -o another name",
+                p.display(),
+                a.output.display()
+            ));
+        }
+    }
     let parts = a
         .parts
         .iter()
         .map(|p| PartFilm::read(p).map_err(|e| e.to_string()))
         .collect::<Result<Vec<_>, _>>()?;
     let m = cov_render::parts::merge(&parts).map_err(|e| e.to_string())?;
-    let [png, density, filter, json, aov] = outputs(&a.output);
     write_image(&m.image, &a.output, &png).map_err(|e| e.to_string())?;
     cov_render::output::write_aovs(&m.film.aovs(), &aov).map_err(|e| e.to_string())?;
     let mut written = vec![a.output.clone(), png, aov];

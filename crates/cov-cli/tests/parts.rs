@@ -96,6 +96,29 @@ fn merged_parts_are_the_single_render() {
         assert_eq!(out.status.code(), Some(2), "{err}");
         assert!(err.contains(want) && err.trim_end().lines().count() == 1, "{err}");
     }
+    // An output that is one of the parts (the EXR, or a file written beside it) is
+    // refused before anything is written: the part survives, byte for byte.
+    let before = std::fs::read(&parts[0]).expect("part 1");
+    let aov_named = tmp("part1");
+    std::fs::copy(&parts[0], aov_named.with_extension("aov.exr")).expect("copy");
+    for (out_name, part) in [
+        (parts[0].clone(), parts[0].clone()),
+        (
+            aov_named.with_extension("exr"),
+            aov_named.with_extension("aov.exr"),
+        ),
+    ] {
+        let mut args = vec!["merge", "-o", s(&out_name), s(&part)];
+        args.extend([s(&parts[1]), s(&parts[2])]);
+        let out = covtrace(&args);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{err}");
+        assert!(
+            err.contains("is also an output of the merge") && err.trim_end().lines().count() == 1,
+            "{err}"
+        );
+    }
+    assert_eq!(std::fs::read(&parts[0]).expect("part 1"), before);
 }
 
 #[test]
