@@ -115,6 +115,19 @@ fn v3a(v: DVec3) -> Vec3A {
 /// breaks the build. Checked where the scene is read and for each frame of an animation.
 pub const MAX_COORD: f64 = 1e12;
 
+/// Smallest size of a sphere's radius or a quad's edge, relative to `1 m +` the largest
+/// |coordinate| of the point it is placed at ([`min_size`]): ten times the offset of a ray
+/// spawned from a surface there (`trace::SPAWN_EPS`, 1e-7 of the same scale). A smaller
+/// shape can be skipped by the rays that leave it, and its own f64 arithmetic (differences
+/// of coordinates of that scale) has lost its digits: a sphere of radius 1e-100 m at 1 m
+/// gave NaN normals.
+pub const MIN_SIZE: f64 = 1e-6;
+
+/// The smallest size (m) of a shape placed at `at` ([`MIN_SIZE`]).
+pub fn min_size(at: DVec3) -> f64 {
+    MIN_SIZE * (1.0 + at.abs().max_element())
+}
+
 impl Prim {
     /// The largest |coordinate| the primitive reaches over the times `t0..t1` (∞ where its
     /// motion overflows).

@@ -22,7 +22,7 @@
 //! | field | unit | meaning |
 //! |---|---|---|
 //! | `camera.position`, `look_at`, `up` | m | pinhole / lens centre, aim point, up vector (default +y) |
-//! | `camera.fov` | degrees | horizontal field of view, in (0, 180) |
+//! | `camera.fov` | degrees | horizontal field of view, from [`crate::world::MIN_FOV`] (1e-6) to below 180 |
 //! | `camera.width`, `height` | px | 1 to [`MAX_RESOLUTION`] each |
 //! | `camera.lens.aperture` | m | lens radius (0: pinhole) |
 //! | `camera.lens.focus_distance` | m | distance of the plane in focus, > 0 |
@@ -36,6 +36,7 @@
 //! | `shapes` | | `Sphere(center, radius, material, velocity)`, `Quad(corner, edge_u, edge_v, material, velocity)`, `Mesh(obj, material, translate, scale, velocity)` |
 //! | colours (`albedo`, texture colours, `radiance`) | | each entry 0 to [`MAX_COLOUR`] (1e9) |
 //! | every shape and light | m | within ±[`crate::geometry::MAX_COORD`] (1e12) of the origin, with its motion over the shutter (and at every frame rendered) |
+//! | a sphere's radius, a quad's or rect light's edges | m | at least [`crate::geometry::MIN_SIZE`] × (1 m + the largest \|coordinate\| of its centre or corner) |
 
 use std::collections::BTreeMap;
 
@@ -363,7 +364,7 @@ pub enum LightDesc {
         /// Centre (m).
         center: V3,
         /// Radius (m).
-        radius: Positive,
+        radius: At<Positive>,
         /// Radiance.
         radiance: Rgb,
     },
@@ -378,7 +379,7 @@ pub enum ShapeDesc {
         /// Centre at time 0 (m).
         center: V3,
         /// Radius (m).
-        radius: Positive,
+        radius: At<Positive>,
         /// Material name.
         material: At<String>,
         /// Velocity (m/s).

@@ -424,6 +424,7 @@ impl World {
         let names = Names(&material_names, "material");
         let any_velocity = shapes(&desc, &names, dir, &mut prims, (t0, t1)).map_err(|(o, m)| at(o, m))?
             || camera.velocity != DVec3::ZERO;
+        large_enough(&desc).map_err(|(o, m)| at(o, m))?;
         Ok(World {
             file: file.to_string(),
             fingerprint: fingerprint(text, &input_files(&desc, dir)),
@@ -460,10 +461,13 @@ fn camera(c: &CameraDesc) -> Result<Camera, Failure> {
     let right = right.normalize();
     let up = right.cross(forward);
     let fov_x = c.fov.value.0.to_radians();
-    if fov_x >= PI {
+    if fov_x >= PI || c.fov.value.0 < MIN_FOV {
         return Err((
             c.fov.ordinal,
-            format!("fov must be below 180 degrees, got {}", c.fov.value.0),
+            format!(
+                "fov must be {MIN_FOV:e} to below 180 degrees, got {}",
+                cov_core::num(c.fov.value.0)
+            ),
         ));
     }
     let (width, height) = (c.width.0, c.height.0);
@@ -744,6 +748,7 @@ fn lights(desc: &SceneFile, prims: &mut Vec<Prim>) -> Result<Vec<Light>, Failure
                 radius,
                 radiance,
             } => {
+                let radius = radius.value;
                 lights.push(Light::Sphere {
                     center: v(*center),
                     radius: radius.0,
@@ -768,6 +773,68 @@ fn lights(desc: &SceneFile, prims: &mut Vec<Prim>) -> Result<Vec<Light>, Failure
         ));
     }
     Ok(lights)
+}
+
+/// Smallest horizontal field of view (degrees): a pixel of the widest image
+/// ([`crate::scene::MAX_RESOLUTION`]) then spans about 2e-12 rad, and the covariance pass's
+/// spectra, which grow as the inverse square of a pixel's angle, stay far inside f64 (at
+/// 1e-300 degrees the sensor's filter spectrum overflowed).
+pub const MIN_FOV: f64 = 1e-6;
+
+/// `Err` at the size if a sphere's radius or a quad's or rect light's edge is below
+/// [`crate::geometry::min_size`] where it is placed (checked after the parallel edges and
+/// the reach of every shape, which are reported first).
+fn large_enough(desc: &SceneFile) -> Result<(), Failure> {
+    let v = |a: V3| DVec3::from_array(a.0);
+    // Each size with where it is placed and where it is written.
+    let mut sizes: Vec<(&str, f64, DVec3, u32)> = Vec::new();
+    // A parallelogram's two edges, at its first edge's position; the largest component
+    // where the length underflows (an edge of 1e-300 m).
+    let edges = |what, corner: V3, eu: &At<V3>, ev: V3| {
+        [v(eu.value), v(ev)].map(|e| (what, e.length().max(e.abs().max_element()), v(corner), eu.ordinal))
+    };
+    for l in &desc.lights.value {
+        match l {
+            LightDesc::Rect {
+                corner,
+                edge_u,
+                edge_v,
+                ..
+            } => sizes.extend(edges("Rect light's edge", *corner, edge_u, *edge_v)),
+            LightDesc::Sphere { center, radius, .. } => {
+                sizes.push(("sphere's radius", radius.value.0, v(*center), radius.ordinal))
+            }
+        }
+    }
+    for s in &desc.shapes {
+        match s {
+            ShapeDesc::Quad {
+                corner,
+                edge_u,
+                edge_v,
+                ..
+            } => sizes.extend(edges("Quad's edge", *corner, edge_u, *edge_v)),
+            ShapeDesc::Sphere { center, radius, .. } => {
+                sizes.push(("sphere's radius", radius.value.0, v(*center), radius.ordinal))
+            }
+            ShapeDesc::Mesh { .. } => {}
+        }
+    }
+    for (what, size, at, ordinal) in sizes {
+        let least = crate::geometry::min_size(at);
+        if size < least {
+            return Err((
+                ordinal,
+                format!(
+                    "this {what} is {} m; at least {} m here ({:e} of 1 m + its distance along an axis from the origin): smaller, rays leaving it skip it and its arithmetic loses its digits",
+                    cov_core::num(size),
+                    cov_core::num(least),
+                    crate::geometry::MIN_SIZE
+                ),
+            ));
+        }
+    }
+    Ok(())
 }
 
 /// `Err` at `ordinal` if a primitive of `prims[from..]` reaches past [`MAX_COORD`] over
@@ -821,7 +888,7 @@ fn shapes(
         match s {
             ShapeDesc::Sphere { center, radius, .. } => push(Shape::Sphere {
                 center: v(*center),
-                radius: radius.0,
+                radius: radius.value.0,
             }),
             ShapeDesc::Quad {
                 corner,

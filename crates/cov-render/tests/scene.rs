@@ -56,7 +56,10 @@ fn checks_after_parsing_point_at_the_value() {
             &[("LOOK", "(0.0, 1.0, 3.0)")],
             "2:50: the camera looks at its own position",
         ),
-        (&[("FOV", "180.0")], "2:72: fov must be below 180 degrees"),
+        (
+            &[("FOV", "180.0")],
+            "2:72: fov must be 1e-6 to below 180 degrees, got 180",
+        ),
         (
             &[("LENS", ", lens: (aperture: 0.01, focus_distance: 0.01)")],
             "2:138: focus_distance 0.01 must exceed the focal length 0.05",
@@ -227,6 +230,41 @@ fn what_single_precision_cannot_hold_is_refused() {
         ),
     ]);
     assert!(error(&fast).contains("reaches 5e299 m"), "{}", error(&fast));
+    // Below what the tracer's offsets and f64 resolve at that scale: refused at the size.
+    for (part, at, what) in [
+        (
+            (
+                "LIGHTS",
+                "[Sphere(center: (0.0, 2.0, 0.0), radius: 1e-100, radiance: (1.0, 1.0, 1.0))]",
+            ),
+            "4:54",
+            "this sphere's radius is 1e-100 m; at least 3e-6 m here",
+        ),
+        (
+            (
+                "SHAPE",
+                r#"Sphere(center: (3.0, 0.5, 0.0), radius: 3.9e-6, material: "w")"#,
+            ),
+            "5:115",
+            "this sphere's radius is 3.9e-6 m; at least 4e-6 m here",
+        ),
+        (
+            (
+                "SHAPE",
+                r#"Quad(corner: (0.0, 0.0, 0.0), edge_u: (1e-9, 0.0, 0.0), edge_v: (0.0, 0.0, 1.0), material: "w")"#,
+            ),
+            "5:113",
+            "this Quad's edge is 1e-9 m; at least 1e-6 m here",
+        ),
+        (
+            ("FOV", "1e-300"),
+            "2:72",
+            "fov must be 1e-6 to below 180 degrees, got 1e-300",
+        ),
+    ] {
+        let e = error(&scene(&[part]));
+        assert!(e.starts_with(&format!("{at}: {what}")), "{e}");
+    }
     let hot = scene(&[(
         "LIGHTS",
         "[Sphere(center: (0.0, 2.0, 0.0), radius: 0.2, radiance: (1e300, 1.0, 1.0))]",
