@@ -28,7 +28,7 @@
 //! | `camera.lens.focus_distance` | m | distance of the plane in focus, > 0 |
 //! | `camera.lens.focal_length` | m | focal length (default 0.05), < focus distance |
 //! | `camera.shutter.open`, `close` | s | shutter interval, `close > open` |
-//! | `camera.velocity` | m/s | camera motion during the shutter |
+//! | `camera.velocity` | m/s | camera motion during the shutter; the camera stays within ±[`crate::geometry::MAX_COORD`] of the origin over it (and at every frame rendered) |
 //! | `camera.frame_rate` | 1/s | frames per second of an animation (`--frame K` moves the shutter and a still's instant by `K / frame_rate`), default 24 |
 //! | `textures` | | named `Checker(checks, a, b)`, `Stripes(count, duty, a, b)`, `Noise(cells, a, b, seed)` (generated; `size` texels per side, default 1024), `Image(file)` (PNG or EXR, relative to the scene file); all take `repeat: (u, v)` |
 //! | `materials` | | named `Diffuse(albedo)`, `Phong(albedo, exponent)`, `Ggx(albedo, alpha)`, each with an optional `texture` that multiplies the albedo |
@@ -215,7 +215,7 @@ pub struct CameraDesc {
     pub shutter: Option<ShutterDesc>,
     /// Camera velocity during the shutter (m/s).
     #[serde(default)]
-    pub velocity: Option<V3>,
+    pub velocity: Option<At<V3>>,
     /// Frames per second of an animation ([`crate::World::at_frame`]); default 24.
     #[serde(default)]
     pub frame_rate: Option<Positive>,

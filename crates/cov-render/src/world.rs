@@ -68,6 +68,16 @@ pub struct CameraRay {
 }
 
 impl Camera {
+    /// The largest |coordinate| of the camera's position over the times `t0..t1` (∞ where
+    /// its motion overflows).
+    pub fn reach(&self, t0: f64, t1: f64) -> f64 {
+        let m = [t0, t1]
+            .map(|t| (self.position + self.velocity * t).abs().max_element())
+            .into_iter()
+            .fold(0.0, f64::max);
+        if m.is_nan() { f64::INFINITY } else { m }
+    }
+
     /// The ray through the image point `(px, py)` (pixels, from the top-left corner), the
     /// lens point `lens` (uniforms in `[0,1)²`, mapped to the disk) and the time uniform
     /// `ut`.
@@ -333,12 +343,12 @@ impl World {
         c.time_offset = f64::from(frame) / c.frame_rate;
         let (t0, t1) = c.shutter.unwrap_or((0.0, 0.0));
         let (t0, t1) = (t0 + c.time_offset, t1 + c.time_offset);
-        let reach = self.geometry.reach(t0, t1);
+        let reach = self.geometry.reach(t0, t1).max(c.reach(t0, t1));
         if reach > MAX_COORD {
             return Err(crate::RenderError::setting(
                 "frame",
                 format!(
-                    "a frame at which every shape stays within ±{MAX_COORD:e} m (this one moves one to {reach:e} m)"
+                    "a frame at which every shape and the camera stay within ±{MAX_COORD:e} m (this one moves one to {reach:e} m)"
                 ),
                 frame,
             ));
@@ -500,7 +510,7 @@ fn camera(c: &CameraDesc) -> Result<Camera, Failure> {
         }
         None => None,
     };
-    Ok(Camera {
+    let camera = Camera {
         position,
         right,
         up,
@@ -516,8 +526,20 @@ fn camera(c: &CameraDesc) -> Result<Camera, Failure> {
         shutter,
         time_offset: 0.0,
         frame_rate: c.frame_rate.map_or(DEFAULT_FRAME_RATE, |r| r.0),
-        velocity: c.velocity.map_or(DVec3::ZERO, v),
-    })
+        velocity: c.velocity.as_ref().map_or(DVec3::ZERO, |u| v(u.value)),
+    };
+    let (t0, t1) = camera.shutter.unwrap_or((0.0, 0.0));
+    let reach = camera.reach(t0, t1);
+    if reach > MAX_COORD {
+        return Err((
+            c.velocity.as_ref().map_or(c.look_at.ordinal, |u| u.ordinal),
+            format!(
+                "the camera reaches {} m from the origin (over the shutter, if it moves): the renderer holds ±{MAX_COORD:e} m",
+                cov_core::num(reach)
+            ),
+        ));
+    }
+    Ok(camera)
 }
 
 /// A colour of the texture `name` (its description at `at`): a reflectance, at most 1 per

@@ -285,7 +285,32 @@ fn what_single_precision_cannot_hold_is_refused() {
     let world = || World::from_text(&drifting, "s.ron", Path::new(".")).expect("within reach at frame 0");
     assert!(world().at_frame(1).is_ok());
     let e = world().at_frame(1000).unwrap_err().to_string();
-    assert!(e.contains("every shape stays within ±1e12 m"), "{e}");
+    assert!(
+        e.contains("every shape and the camera stay within ±1e12 m"),
+        "{e}"
+    );
+    // The camera too: far by its motion over the shutter (where the velocity is), and by
+    // a frame of its drift.
+    let flying = scene(&[(
+        "LENS",
+        ", shutter: (open: 0.0, close: 0.1), velocity: (1e300, 0.0, 0.0)",
+    )]);
+    let e = error(&flying);
+    assert!(
+        e.starts_with("2:143: the camera reaches 1e299 m from the origin"),
+        "{e}"
+    );
+    let drifting = scene(&[(
+        "LENS",
+        ", shutter: (open: 0.0, close: 0.01), velocity: (1e11, 0.0, 0.0)",
+    )]);
+    let world = || World::from_text(&drifting, "s.ron", Path::new(".")).expect("within reach at frame 0");
+    assert!(world().at_frame(1).is_ok());
+    let e = world().at_frame(1000).unwrap_err().to_string();
+    assert!(
+        e.contains("every shape and the camera stay within ±1e12 m"),
+        "{e}"
+    );
 }
 
 /// A material or texture name given twice is an error where the second definition is,
