@@ -610,6 +610,12 @@ pub fn check(a: &CheckArgs) -> Result<String, String> {
     }
     let world = load(&a.scene, a.size)?;
     let (w, h) = (world.camera.width, world.camera.height);
+    let t = cov_render::validate::T as u32;
+    if w < t || h < t {
+        return Err(format!(
+            "render-check compares tiles of {t}×{t} px: the image ({w}×{h} px) must be at least that (--size)"
+        ));
+    }
     let tiles = tile_count(&world);
     let uniform = |spp: u32, seed: u64, max_luminance: f64| RenderSettings {
         method: Method::Uniform,
@@ -664,6 +670,8 @@ pub fn check(a: &CheckArgs) -> Result<String, String> {
         std::fs::write(j, text).map_err(|e| format!("{}: {e}", j.display()))?;
     }
     let n = agreement.tiles.len();
+    // A rank correlation needs two tiles with detail; fewer, and it is not defined.
+    let defined = |v: f64| if agreement.detail_tiles >= 2 { v } else { f64::NAN };
     Ok(format!(
         "scene: {} ({w}×{h} px), two references of {} spp in {t_ref:.1} s, covariance {} path(s) per pixel in {t_cov:.2} s\n\
          tiles of {t}×{t} px: {n}, with detail: {}\n\
@@ -676,9 +684,9 @@ pub fn check(a: &CheckArgs) -> Result<String, String> {
         a.cov_paths,
         agreement.detail_tiles,
         fmt_num(agreement.median_ratio),
-        fmt_num(agreement.rank_correlation),
-        fmt_num(agreement.variation_correlation),
-        fmt_num(agreement.contrast_correlation),
+        fmt_num(defined(agreement.rank_correlation)),
+        fmt_num(defined(agreement.variation_correlation)),
+        fmt_num(defined(agreement.contrast_correlation)),
         100.0 * agreement.undersampled,
         t = cov_render::validate::T,
     ))

@@ -175,3 +175,31 @@ fn the_stiff_length_is_bounded() {
         assert_eq!(err.trim_end().lines().count(), 1, "{err}");
     }
 }
+
+/// `render-check` on an image smaller than one of its tiles: one line and exit code 2,
+/// not a report of zeros; with a single tile, the rank correlations it cannot define read
+/// `n/a`.
+#[test]
+fn render_check_needs_tiles() {
+    let o = covtrace(&["render-check", "examples/scenes/cornell.ron", "--size", "1x1"]);
+    assert_eq!(o.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        err.contains("must be at least that") && err.trim_end().lines().count() == 1,
+        "{err}"
+    );
+    let o = covtrace(&[
+        "render-check",
+        "examples/scenes/cornell.ron",
+        "--size",
+        "16x16",
+        "--ref-spp",
+        "4",
+    ]);
+    let out = String::from_utf8_lossy(&o.stdout);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert!(
+        out.contains("rank correlation (Spearman) over tiles with detail: n/a"),
+        "{out}"
+    );
+}
