@@ -25,7 +25,7 @@ pub struct RenderArgs {
     #[arg(long, default_value = "cov", value_parser = parse_method)]
     pub method: Method,
     /// Average samples per pixel (of each pass, with --time).
-    #[arg(long, default_value_t = 16)]
+    #[arg(long, default_value_t = 16, value_parser = parse_spp)]
     pub spp: u32,
     /// Render progressively: passes of --spp over the same per-pixel sequences until
     /// this many seconds are spent (covariance pass included).
@@ -117,6 +117,19 @@ pub fn parse_frames(s: &str) -> Result<(u32, u32), String> {
         return Err(bad());
     }
     Ok((a, b))
+}
+
+/// Parses `--spp`: a whole number of samples per pixel, 1 to [`cov_render::MAX_SPP`].
+///
+/// # Errors
+/// Not a whole number, or out of range.
+pub fn parse_spp(s: &str) -> Result<u32, String> {
+    let max = cov_render::MAX_SPP;
+    s.trim()
+        .parse::<u32>()
+        .ok()
+        .filter(|n| (1..=max).contains(n))
+        .ok_or_else(|| format!("must be a whole number of samples per pixel, 1 to {max}"))
 }
 
 /// Most frames one `covtrace render --frames A..B` renders.

@@ -122,8 +122,23 @@ fn bad_scene_files_give_one_positioned_line() {
     ]);
     assert_eq!(out.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&out.stderr).contains("no such folder"));
-    let out = covtrace(&["render", "examples/scenes/pool.ron", "--spp", "0"]);
-    assert_eq!(out.status.code(), Some(2));
+    // A count out of range or not a whole number says what --spp takes; a huge --time is
+    // printed compactly.
+    for spp in ["0", "1e12", "70000", "2.5"] {
+        let out = covtrace(&["render", "examples/scenes/pool.ron", "--spp", spp]);
+        assert_eq!(out.status.code(), Some(2));
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(
+            err.contains("must be a whole number of samples per pixel, 1 to 65536"),
+            "{err}"
+        );
+    }
+    let out = covtrace(&["render", "examples/scenes/pool.ron", "--time", "1e300"]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("at most 604800 s, got 1e300") && err.len() < 120,
+        "{err}"
+    );
 }
 
 /// Renders `scene` at 32×24 with `extra` arguments into `name.exr`; returns the EXR's

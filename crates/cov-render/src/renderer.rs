@@ -207,7 +207,7 @@ impl RenderSettings {
             return Err(RenderError::setting(
                 "spp",
                 format!("1 to {MAX_SPP} samples per pixel"),
-                self.spp,
+                cov_core::num(self.spp),
             ));
         }
         if let Some(t) = self.time
@@ -216,7 +216,7 @@ impl RenderSettings {
             return Err(RenderError::setting(
                 "time",
                 format!("more than 0 and at most {MAX_TIME} s"),
-                t,
+                cov_core::num(t),
             ));
         }
         if !(1..=MAX_COV_PATHS).contains(&self.cov_paths) {
