@@ -22,7 +22,7 @@
 //! | field | unit | meaning |
 //! |---|---|---|
 //! | `camera.position`, `look_at`, `up` | m | pinhole / lens centre, aim point, up vector (default +y) |
-//! | `camera.fov` | degrees | horizontal field of view, from [`crate::world::MIN_FOV`] (1e-6) to below 180 |
+//! | `camera.fov` | degrees | horizontal field of view, from [`MIN_FOV`] (1e-6) to below 180 |
 //! | `camera.width`, `height` | px | 1 to [`MAX_RESOLUTION`] each |
 //! | `camera.lens.aperture` | m | lens radius (0: pinhole) |
 //! | `camera.lens.focus_distance` | m | distance of the plane in focus, > 0 |
@@ -47,6 +47,12 @@ pub use crate::error::SceneError;
 
 /// Largest image side (px): bounds memory (a float RGB image of 8192² is 800 MB).
 pub const MAX_RESOLUTION: u32 = 8192;
+/// Smallest horizontal field of view (degrees): a pixel of the widest image
+/// ([`MAX_RESOLUTION`]) then spans about 2e-12 rad, and the covariance pass's
+/// spectra, which grow as the inverse square of a pixel's angle, stay far inside f64 (at
+/// 1e-300 degrees the sensor's filter spectrum overflowed).
+pub const MIN_FOV: f64 = 1e-6;
+
 /// Largest scene file read (bytes).
 pub const MAX_SCENE_BYTES: u64 = 16 << 20;
 /// Largest number of triangles over all meshes of a scene.

@@ -471,11 +471,12 @@ fn camera(c: &CameraDesc) -> Result<Camera, Failure> {
     let right = right.normalize();
     let up = right.cross(forward);
     let fov_x = c.fov.value.0.to_radians();
-    if fov_x >= PI || c.fov.value.0 < MIN_FOV {
+    if fov_x >= PI || c.fov.value.0 < crate::scene::MIN_FOV {
         return Err((
             c.fov.ordinal,
             format!(
-                "fov must be {MIN_FOV:e} to below 180 degrees, got {}",
+                "fov must be {:e} to below 180 degrees, got {}",
+                crate::scene::MIN_FOV,
                 cov_core::num(c.fov.value.0)
             ),
         ));
@@ -796,12 +797,6 @@ fn lights(desc: &SceneFile, prims: &mut Vec<Prim>) -> Result<Vec<Light>, Failure
     }
     Ok(lights)
 }
-
-/// Smallest horizontal field of view (degrees): a pixel of the widest image
-/// ([`crate::scene::MAX_RESOLUTION`]) then spans about 2e-12 rad, and the covariance pass's
-/// spectra, which grow as the inverse square of a pixel's angle, stay far inside f64 (at
-/// 1e-300 degrees the sensor's filter spectrum overflowed).
-pub const MIN_FOV: f64 = 1e-6;
 
 /// `Err` at the size if a sphere's radius or a quad's or rect light's edge is below
 /// [`crate::geometry::min_size`] where it is placed (checked after the parallel edges and
