@@ -397,7 +397,13 @@ impl World {
                 meta.len()
             )));
         }
-        let bytes = std::fs::read(path).map_err(|e| err(e.to_string()))?;
+        // Read up to one byte past the bound: a device or a pipe reports no length.
+        let bytes = read_at_most(path, MAX_SCENE_BYTES).map_err(|e| err(e.to_string()))?;
+        if bytes.len() as u64 > MAX_SCENE_BYTES {
+            return Err(err(format!(
+                "the file is more than {MAX_SCENE_BYTES} bytes; scene files are read up to that"
+            )));
+        }
         let text = String::from_utf8(bytes).map_err(|e| {
             let (line, col) = cov_core::utf8_error_at(e.as_bytes()).map_or((1, 1), |(l, c, _)| (l, c));
             SceneError {
@@ -561,11 +567,62 @@ fn reflectance(c: Rgb, name: &At<String>, at: u32) -> Result<DVec3, Failure> {
 
 /// Largest side of a generated texture, by default (texels).
 pub const DEFAULT_TEXTURE_SIZE: u32 = 1024;
+/// Most texels over all the textures of a scene (used or not): two textures of the
+/// largest side ([`crate::texture::MAX_TEXTURE_SIDE`]), about 1.4 GB with their pyramids.
+/// Each texture alone is bounded by its side; without this, a few kilobytes of scene
+/// asked for tens of gigabytes.
+pub const MAX_SCENE_TEXELS: usize = 2 * 4096 * 4096;
+/// Largest OBJ file read (bytes): about 70 bytes a triangle for [`MAX_TRIANGLES`].
+pub const MAX_OBJ_BYTES: u64 = 350 << 20;
+
+/// `Err` at `at` if the scene's textures up to `name` hold more than
+/// [`MAX_SCENE_TEXELS`] (`texels`); `made`: counted after the texture was made, not before.
+fn too_many_texels(texels: usize, name: &At<String>, at: u32, made: bool) -> Result<(), Failure> {
+    if texels <= MAX_SCENE_TEXELS {
+        return Ok(());
+    }
+    Err((
+        at,
+        format!(
+            "texture `{}` {} the scene's textures to {texels} texels; a scene holds at most {MAX_SCENE_TEXELS} (two of 4096², about 1.4 GB with their pyramids)",
+            crate::echo(&name.value),
+            if made { "brings" } else { "would bring" }
+        ),
+    ))
+}
+
+/// The first `limit + 1` bytes of `path` at most (a file, or a device or pipe whose
+/// length is not known beforehand): more than `limit` means the input is too large.
+fn read_at_most(path: &Path, limit: u64) -> std::io::Result<Vec<u8>> {
+    use std::io::Read;
+    let mut bytes = Vec::new();
+    std::fs::File::open(path)?
+        .take(limit + 1)
+        .read_to_end(&mut bytes)?;
+    Ok(bytes)
+}
 
 /// The textures, and their names, in the order of the file's map.
 fn textures(desc: &SceneFile, dir: &Path) -> Result<(Vec<TextureMap>, Vec<String>), Failure> {
     let mut maps = Vec::new();
     let mut names = Vec::new();
+    // The procedural textures' texels are known before any is made: too many, and none is.
+    let mut texels = 0usize;
+    for (name, t) in &desc.textures {
+        let side = match &t.value {
+            TextureDesc::Image { .. } => 0,
+            TextureDesc::Checker { size, .. }
+            | TextureDesc::Stripes { size, .. }
+            | TextureDesc::Noise { size, .. } => {
+                size.unwrap_or(DEFAULT_TEXTURE_SIZE)
+                    .min(crate::texture::MAX_TEXTURE_SIDE) as usize
+            }
+        };
+        texels += side * side;
+        too_many_texels(texels, name, t.ordinal, false)?;
+    }
+    // Then every texture's, images included, as they are made.
+    let mut texels = 0usize;
     for (name, t) in &desc.textures {
         let rep = |r: &Option<(crate::scene::Positive, crate::scene::Positive)>| {
             r.map_or(DVec2::ONE, |(a, b)| DVec2::new(a.0, b.0))
@@ -631,6 +688,9 @@ fn textures(desc: &SceneFile, dir: &Path) -> Result<(Vec<TextureMap>, Vec<String
             ),
         };
         let map = map.map_err(|e| (at, format!("texture `{}`: {e}", crate::echo(&name.value))))?;
+        let (w, h) = map.size();
+        texels += w * h;
+        too_many_texels(texels, name, at, true)?;
         maps.push(map);
         names.push(name.value.clone());
     }
@@ -975,7 +1035,17 @@ fn load_obj(path: &Path, limit: usize) -> Result<Vec<ObjTriangle>, String> {
         single_index: true,
         ..Default::default()
     };
-    let (models, _materials) = tobj::load_obj(path, &opts).map_err(|e| cov_core::one_line(&e.to_string()))?;
+    let bytes = read_at_most(path, MAX_OBJ_BYTES).map_err(|e| cov_core::one_line(&e.to_string()))?;
+    if bytes.len() as u64 > MAX_OBJ_BYTES {
+        return Err(format!(
+            "the file is more than {MAX_OBJ_BYTES} bytes; OBJ files are read up to that"
+        ));
+    }
+    // Materials come from the scene: an `mtllib` line is not followed (it could name a
+    // device or a pipe).
+    let no_materials = |_: &Path| Ok((Vec::new(), Default::default()));
+    let (models, _materials) = tobj::load_obj_buf(&mut &bytes[..], &opts, no_materials)
+        .map_err(|e| cov_core::one_line(&e.to_string()))?;
     let mut out = Vec::new();
     for m in &models {
         let mesh = &m.mesh;

@@ -343,3 +343,48 @@ fn a_path_that_is_not_a_file_says_so() {
     let missing = scene(&[("SHAPE", r#"Mesh(obj: "missing.obj", material: "w")"#)]);
     assert!(error(&missing).contains("no such file"), "{}", error(&missing));
 }
+
+/// What a few bytes of input must not make the loader do: read a device without end,
+/// follow an OBJ's `mtllib` (to a device or a pipe), or make textures of tens of
+/// gigabytes. Each is refused, or ignored for `mtllib`, at once.
+#[test]
+fn small_inputs_cannot_ask_for_unbounded_work() {
+    // A scene read from a device: cut at the bound, one line.
+    let e = World::load(Path::new("/dev/zero")).unwrap_err().to_string();
+    assert!(
+        e.contains("more than 16777216 bytes; scene files are read up to that"),
+        "{e}"
+    );
+    // An OBJ naming a material library on a device: the mesh loads, the library is not read.
+    let dir = std::env::temp_dir().join(format!("covtrace-scene-test-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).expect("temp dir");
+    std::fs::write(
+        dir.join("tri.obj"),
+        "mtllib /dev/zero\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl x\nf 1 2 3\n",
+    )
+    .expect("write");
+    let text = scene(&[("SHAPE", r#"Mesh(obj: "tri.obj", material: "w")"#)]);
+    let world = World::from_text(&text, "s.ron", &dir).expect("the mesh loads");
+    assert!(world.geometry.len() >= 2, "{}", world.geometry.len());
+    // Three procedural textures of 4096² (2 GB with their pyramids): refused at the third
+    // before any is made.
+    let big = BASE.replace(
+        "    materials:",
+        &format!(
+            "    textures: {{ {} }},\n    materials:",
+            (0..3)
+                .map(|i| format!(
+                    "\"t{i}\": Checker(checks: (2, 2), a: (1.0, 1.0, 1.0), b: (0.0, 0.0, 0.0), size: 4096)"
+                ))
+                .collect::<Vec<_>>()
+                .join(", ")
+        ),
+    );
+    let e = error(&scene_from(&big));
+    assert!(
+        e.contains(
+            "texture `t2` would bring the scene's textures to 50331648 texels; a scene holds at most 33554432"
+        ),
+        "{e}"
+    );
+}
