@@ -270,11 +270,39 @@ fn reference(
 /// Bad arguments or scene, unwritable outputs.
 pub fn bench(a: &BenchArgs) -> Result<String, String> {
     let (methods, budgets) = check_args(a)?;
-    let text = std::fs::read(&a.scene).map_err(|e| format!("{}: {e}", a.scene.display()))?;
     folder(&a.output, "output folder")?;
     let cache = a.cache.clone().unwrap_or_else(|| a.output.clone());
     folder(&cache, "cache folder")?;
     let world = crate::render::load(&a.scene, a.size)?;
+    // The scene's text keys the cached reference; read as the scene was, within its bound.
+    let text = {
+        use std::io::Read;
+        let mut t = Vec::new();
+        std::fs::File::open(&a.scene)
+            .and_then(|f| f.take(cov_render::scene::MAX_SCENE_BYTES).read_to_end(&mut t))
+            .map_err(|e| format!("{}: {e}", crate::render::shown(&a.scene)))?;
+        t
+    };
+    // What the run writes in the output folder must not be what it reads.
+    let mut written: Vec<std::path::PathBuf> = [
+        "results.csv",
+        "results.json",
+        "error_time.png",
+        "error_time.svg",
+        "strip.png",
+    ]
+    .iter()
+    .map(|f| a.output.join(f))
+    .collect();
+    for m in &methods {
+        for ext in ["exr", "png", "error.png"] {
+            written.push(a.output.join(format!("{}.{ext}", m.name())));
+        }
+    }
+    let read: Vec<std::path::PathBuf> = std::iter::once(a.scene.clone())
+        .chain(world.inputs.iter().cloned())
+        .collect();
+    crate::render::not_an_input(&written, &read, "-o")?;
     let (w, h) = (world.camera.width, world.camera.height);
     let mut out = format!(
         "scene: {} ({w}×{h} px)\n",

@@ -193,6 +193,7 @@ fn run(cli: Cli, registry: &Registry) -> Result<(), String> {
         }
         Command::Plot { path, output } => {
             crate::render::check_output(&output, "png")?;
+            crate::render::not_an_input(std::slice::from_ref(&output), std::slice::from_ref(&path), "-o")?;
             let p = Path::load(&path, registry).map_err(|e| e.to_string())?;
             let e = p.eval().map_err(|e| e.to_string())?;
             let legend = plot::plot(&e, &path.display().to_string(), &output)?;

@@ -255,19 +255,72 @@ pub fn outputs(exr: &Path) -> [PathBuf; 5] {
 /// A wrong extension, a missing or unwritable folder.
 pub fn check_output(out: &Path, ext: &str) -> Result<(), String> {
     if out.extension().and_then(|e| e.to_str()) != Some(ext) {
-        return Err(format!("{}: the output must be a .{ext} file", out.display()));
+        return Err(format!("{}: the output must be a .{ext} file", shown(out)));
     }
     let dir = match out.parent() {
         Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
         _ => PathBuf::from("."),
     };
     if !dir.is_dir() {
-        return Err(format!("{}: no such folder", dir.display()));
+        return Err(format!("{}: no such folder", shown(&dir)));
     }
     let probe = dir.join(format!(".covtrace-write-test-{}", std::process::id()));
-    std::fs::write(&probe, b"").map_err(|e| format!("{}: cannot write here: {e}", dir.display()))?;
+    std::fs::write(&probe, b"").map_err(|e| format!("{}: cannot write here: {e}", shown(&dir)))?;
     let _ = std::fs::remove_file(probe);
     Ok(())
+}
+
+/// A path as an error shows it: on one line, shortened ([`cov_render::echo`]).
+pub fn shown(p: &Path) -> String {
+    cov_render::echo(&p.display().to_string())
+}
+
+/// Refuses to write any of `outputs` (named by the option `option`) over one of `inputs`,
+/// by whatever path it is reached (`./x`, a link, a hard link): an input lost is work to
+/// do again, or gone.
+///
+/// # Errors
+/// An output that is an input, in one line.
+pub fn not_an_input(outputs: &[PathBuf], inputs: &[PathBuf], option: &str) -> Result<(), String> {
+    for o in outputs {
+        if let Some(i) = inputs.iter().find(|i| same_file(o, i)) {
+            return Err(format!(
+                "{}: an input of this run, which {option} {} would overwrite; give {option} another name",
+                shown(i),
+                shown(o)
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// Whether `a` and `b` are the same existing file (on Unix the same device and inode, so
+/// a hard link counts).
+fn same_file(a: &Path, b: &Path) -> bool {
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::MetadataExt;
+        match (std::fs::metadata(a), std::fs::metadata(b)) {
+            (Ok(x), Ok(y)) => x.dev() == y.dev() && x.ino() == y.ino(),
+            _ => false,
+        }
+    }
+    #[cfg(not(unix))]
+    {
+        matches!((a.canonicalize(), b.canonicalize()), (Ok(x), Ok(y)) if x == y)
+    }
+}
+
+/// The files `render` writes for the EXR `exr`, the EXR first.
+fn written(exr: &Path) -> Vec<PathBuf> {
+    std::iter::once(exr.to_path_buf()).chain(outputs(exr)).collect()
+}
+
+/// The files a run on `world`, loaded from `scene`, reads.
+fn read_by(scene: &Path, world: &World) -> Vec<PathBuf> {
+    std::iter::once(scene.to_path_buf())
+        .chain(world.inputs.iter().cloned())
+        .collect()
 }
 
 /// Checks `--ref-spp` (1 to [`MAX_SPP`]) and `--cov-paths` (1 to [`MAX_COV_PATHS`]).
@@ -355,6 +408,7 @@ fn render_one(
     world: &World,
     output: &Path,
 ) -> Result<String, String> {
+    not_an_input(&written(output), &read_by(&a.scene, world), "-o")?;
     if let Some(p) = a.part {
         return render_part(a, settings, world, p, output);
     }
@@ -496,19 +550,7 @@ pub fn merge(a: &MergeArgs) -> Result<String, String> {
     }
     let [png, density, filter, json, aov] = outputs(&a.output);
     // A merge must not overwrite the parts it reads: a part lost is a job to run again.
-    let same = |x: &Path, y: &Path| match (x.canonicalize(), y.canonicalize()) {
-        (Ok(x), Ok(y)) => x == y,
-        _ => false,
-    };
-    for out in [&a.output, &png, &density, &filter, &json, &aov] {
-        if let Some(p) = a.parts.iter().find(|p| same(p, out)) {
-            return Err(format!(
-                "{}: this part file is also an output of the merge (-o {}), which would overwrite it; give -o another name",
-                p.display(),
-                a.output.display()
-            ));
-        }
-    }
+    not_an_input(&written(&a.output), &a.parts, "-o")?;
     let parts = a
         .parts
         .iter()
@@ -622,6 +664,9 @@ pub fn check(a: &CheckArgs) -> Result<String, String> {
         check_output(j, "json")?;
     }
     let world = load(&a.scene, a.size)?;
+    if let Some(j) = &a.json {
+        not_an_input(std::slice::from_ref(j), &read_by(&a.scene, &world), "--json")?;
+    }
     let (w, h) = (world.camera.width, world.camera.height);
     let t = cov_render::validate::T as u32;
     if w < t || h < t {

@@ -203,3 +203,99 @@ fn render_check_needs_tiles() {
         "{out}"
     );
 }
+
+/// No command writes over what it reads: a scene's texture under `render -o`, the scene
+/// itself through a file written beside the image or through a hard link, a path file
+/// under `plot -o`, a scene under `render-check --json`, and a scene in render-bench's
+/// output folder. One line, exit code 2, and the input unchanged.
+#[test]
+fn outputs_never_overwrite_inputs() {
+    let dir = std::env::temp_dir().join(format!("covtrace-hostile-test-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(dir.join("textures")).expect("dir");
+    let scenes = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/scenes");
+    for f in ["snooker.ron", "cornell.ron"] {
+        std::fs::copy(scenes.join(f), dir.join(f)).expect("copy");
+    }
+    for e in std::fs::read_dir(scenes.join("textures"))
+        .expect("textures")
+        .flatten()
+    {
+        std::fs::copy(e.path(), dir.join("textures").join(e.file_name())).expect("copy");
+    }
+    let d = |f: &str| dir.join(f).to_str().expect("utf-8").to_string();
+    std::fs::copy(dir.join("cornell.ron"), dir.join("scene.cov.json")).expect("copy");
+    std::fs::hard_link(dir.join("cornell.ron"), dir.join("linked.exr")).expect("link");
+    std::fs::copy(
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/paths/brdf.ron"),
+        dir.join("demo.png"),
+    )
+    .expect("copy");
+    std::fs::create_dir_all(dir.join("rb")).expect("dir");
+    std::fs::copy(dir.join("cornell.ron"), dir.join("rb/results.csv")).expect("copy");
+    let texture = std::fs::read_dir(dir.join("textures"))
+        .expect("textures")
+        .flatten()
+        .map(|e| e.path())
+        .find(|p| p.extension().is_some_and(|x| x == "png"))
+        .expect("a PNG texture");
+    let tex_exr = texture.with_extension("exr");
+    let before: Vec<Vec<u8>> = [
+        texture.clone(),
+        dir.join("scene.cov.json"),
+        dir.join("cornell.ron"),
+        dir.join("demo.png"),
+        dir.join("rb/results.csv"),
+    ]
+    .iter()
+    .map(|p| std::fs::read(p).expect("input"))
+    .collect();
+    let small = ["--size", "32x24", "--spp", "1"];
+    let runs: Vec<Vec<String>> = vec![
+        vec![
+            "render".into(),
+            d("snooker.ron"),
+            "-o".into(),
+            tex_exr.to_str().expect("utf-8").into(),
+        ],
+        vec!["render".into(), d("scene.cov.json"), "-o".into(), d("scene.exr")],
+        vec!["render".into(), d("cornell.ron"), "-o".into(), d("linked.exr")],
+        vec!["plot".into(), d("demo.png"), "-o".into(), d("demo.png")],
+        vec![
+            "render-bench".into(),
+            d("rb/results.csv"),
+            "--size".into(),
+            "16x16".into(),
+            "--ref-spp".into(),
+            "4".into(),
+            "--budgets".into(),
+            "2".into(),
+            "-o".into(),
+            d("rb"),
+        ],
+    ];
+    for (k, run) in runs.iter().enumerate() {
+        let mut args: Vec<&str> = run.iter().map(String::as_str).collect();
+        if k < 3 {
+            args.extend(small);
+        }
+        let o = covtrace(&args);
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "{args:?}: {err}");
+        assert!(
+            err.contains("an input of this run, which") && err.trim_end().lines().count() == 1,
+            "{args:?}: {err}"
+        );
+    }
+    let after: Vec<Vec<u8>> = [
+        texture,
+        dir.join("scene.cov.json"),
+        dir.join("cornell.ron"),
+        dir.join("demo.png"),
+        dir.join("rb/results.csv"),
+    ]
+    .iter()
+    .map(|p| std::fs::read(p).expect("input"))
+    .collect();
+    assert!(before == after, "an input changed");
+}

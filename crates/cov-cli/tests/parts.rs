@@ -114,7 +114,9 @@ fn merged_parts_are_the_single_render() {
         let err = String::from_utf8_lossy(&out.stderr);
         assert_eq!(out.status.code(), Some(2), "{err}");
         assert!(
-            err.contains("is also an output of the merge") && err.trim_end().lines().count() == 1,
+            err.contains("an input of this run, which -o")
+                && err.contains("would overwrite")
+                && err.trim_end().lines().count() == 1,
             "{err}"
         );
     }

@@ -305,6 +305,9 @@ pub struct World {
     pub lights: Vec<Light>,
     /// Primitives under a BVH.
     pub geometry: Geometry,
+    /// The files the scene reads besides itself (image textures, OBJ meshes), as
+    /// resolved from its folder.
+    pub inputs: Vec<std::path::PathBuf>,
     /// Whether anything moves during an open shutter (the covariance is then traced with
     /// a time axis, layout 5; else layout 4).
     pub has_motion: bool,
@@ -441,9 +444,11 @@ impl World {
         let any_velocity = shapes(&desc, &names, dir, &mut prims, (t0, t1)).map_err(|(o, m)| at(o, m))?
             || camera.velocity != DVec3::ZERO;
         large_enough(&desc).map_err(|(o, m)| at(o, m))?;
+        let inputs = input_files(&desc, dir);
         Ok(World {
             file: file.to_string(),
-            fingerprint: fingerprint(text, &input_files(&desc, dir)),
+            fingerprint: fingerprint(text, &inputs),
+            inputs,
             frame: 0,
             has_motion: camera.shutter.is_some() && any_velocity,
             camera,
