@@ -24,10 +24,10 @@
 //! | `camera.position`, `look_at`, `up` | m | pinhole / lens centre, aim point, up vector (default +y) |
 //! | `camera.fov` | degrees | horizontal field of view, from [`MIN_FOV`] (1e-6) to below 180 |
 //! | `camera.width`, `height` | px | 1 to [`MAX_RESOLUTION`] each |
-//! | `camera.lens.aperture` | m | lens radius (0: pinhole) |
+//! | `camera.lens.aperture` | m | lens radius: 0 (pinhole) or [`LENS_RANGE`] (1e-9 to 1e6) |
 //! | `camera.lens.focus_distance` | m | distance of the plane in focus, > 0 |
-//! | `camera.lens.focal_length` | m | focal length (default 0.05), < focus distance |
-//! | `camera.shutter.open`, `close` | s | shutter interval, `close > open` |
+//! | `camera.lens.focal_length` | m | focal length (default 0.05) in [`LENS_RANGE`], < focus distance |
+//! | `camera.shutter.open`, `close` | s | shutter interval, `close − open` in [`SHUTTER_RANGE`] (1e-15 to 1e6) |
 //! | `camera.velocity` | m/s | camera motion during the shutter; the camera stays within ±[`crate::geometry::MAX_COORD`] of the origin over it (and at every frame rendered) |
 //! | `camera.frame_rate` | 1/s | frames per second of an animation (`--frame K` moves the shutter and a still's instant by `K / frame_rate`), default 24 |
 //! | `textures` | | named `Checker(checks, a, b)`, `Stripes(count, duty, a, b)`, `Noise(cells, a, b, seed)` (generated; `size` texels per side, default 1024), `Image(file)` (PNG or EXR, relative to the scene file); all take `repeat: (u, v)` |
@@ -52,6 +52,15 @@ pub const MAX_RESOLUTION: u32 = 8192;
 /// spectra, which grow as the inverse square of a pixel's angle, stay far inside f64 (at
 /// 1e-300 degrees the sensor's filter spectrum overflowed).
 pub const MIN_FOV: f64 = 1e-6;
+
+/// The range (m) of a lens's radius (besides 0, a pinhole) and of its focal length: a
+/// nanometre to a thousand kilometres. The covariance pass's lens spectra grow as the
+/// inverse square of these lengths, and the sensor holds apertures up to 1e6; an aperture
+/// of 1e-155 m overflowed, one of 1e-30 predicted no samples at all.
+pub const LENS_RANGE: (f64, f64) = (1e-9, 1e6);
+/// The range (s) of the shutter's opening time `close − open`: a femtosecond to the
+/// sensor's largest shutter. One of 1e-160 s overflowed the shutter's spectrum.
+pub const SHUTTER_RANGE: (f64, f64) = (1e-15, 1e6);
 
 /// Largest scene file read (bytes).
 pub const MAX_SCENE_BYTES: u64 = 16 << 20;
@@ -232,12 +241,12 @@ pub struct CameraDesc {
 #[serde(deny_unknown_fields, rename = "Lens")]
 pub struct LensDesc {
     /// Lens radius (m); 0 is a pinhole.
-    pub aperture: NonNegative,
+    pub aperture: At<NonNegative>,
     /// Distance in focus (m).
     pub focus_distance: At<Positive>,
     /// Focal length (m), default 0.05.
     #[serde(default)]
-    pub focal_length: Option<Positive>,
+    pub focal_length: Option<At<Positive>>,
 }
 
 /// The shutter interval (s).

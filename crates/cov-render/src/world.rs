@@ -495,21 +495,53 @@ fn camera(c: &CameraDesc) -> Result<Camera, Failure> {
     let (width, height) = (c.width.0, c.height.0);
     let tan_x = (fov_x / 2.0).tan();
     let tan_y = tan_x * height as f64 / width as f64;
+    let (lo, hi) = crate::scene::LENS_RANGE;
+    let in_lens_range = |what: &str, v: f64, at: u32| {
+        if (lo..=hi).contains(&v) {
+            Ok(())
+        } else {
+            Err((
+                at,
+                format!("{what} must be {lo:e} to {hi:e} m, got {}", cov_core::num(v)),
+            ))
+        }
+    };
     let (lens_radius, focus_distance, focal_length) = match &c.lens {
         Some(l) => {
-            let f = l.focal_length.map_or(0.05, |f| f.0);
+            let f = l.focal_length.as_ref().map_or(0.05, |f| f.value.0);
+            if let Some(fl) = &l.focal_length {
+                in_lens_range("focal_length", f, fl.ordinal)?;
+            }
+            let r = l.aperture.value.0;
+            if r != 0.0 {
+                in_lens_range("aperture (0 for a pinhole)", r, l.aperture.ordinal)?;
+            }
             let d = l.focus_distance.value.0;
             if d <= f {
                 return Err((
                     l.focus_distance.ordinal,
-                    format!("focus_distance {d} must exceed the focal length {f} (a real image)"),
+                    format!(
+                        "focus_distance {} must exceed the focal length {} (a real image)",
+                        cov_core::num(d),
+                        cov_core::num(f)
+                    ),
                 ));
             }
-            (l.aperture.0, d, f)
+            (r, d, f)
         }
         None => (0.0, 1.0, 0.05),
     };
+    let (slo, shi) = crate::scene::SHUTTER_RANGE;
     let shutter = match &c.shutter {
+        Some(s) if s.close.value.0 > s.open.0 && !(slo..=shi).contains(&(s.close.value.0 - s.open.0)) => {
+            return Err((
+                s.close.ordinal,
+                format!(
+                    "the shutter must stay open {slo:e} to {shi:e} s (close − open), got {}",
+                    cov_core::num(s.close.value.0 - s.open.0)
+                ),
+            ));
+        }
         Some(s) if s.close.value.0 > s.open.0 => Some((s.open.0, s.close.value.0)),
         Some(s) => {
             return Err((

@@ -261,6 +261,24 @@ fn what_single_precision_cannot_hold_is_refused() {
             "2:72",
             "fov must be 1e-6 to below 180 degrees, got 1e-300",
         ),
+        (
+            ("LENS", ", lens: (aperture: 1e-155, focus_distance: 4.0)"),
+            "2:116",
+            "aperture (0 for a pinhole) must be 1e-9 to 1e6 m, got 1e-155",
+        ),
+        (
+            (
+                "LENS",
+                ", lens: (aperture: 0.01, focus_distance: 4.0, focal_length: 1e-300)",
+            ),
+            "2:157",
+            "focal_length must be 1e-9 to 1e6 m, got 1e-300",
+        ),
+        (
+            ("LENS", ", shutter: (open: 0.0, close: 1e-160)"),
+            "2:127",
+            "the shutter must stay open 1e-15 to 1e6 s (close − open), got 1e-160",
+        ),
     ] {
         let e = error(&scene(&[part]));
         assert!(e.starts_with(&format!("{at}: {what}")), "{e}");
