@@ -217,9 +217,15 @@ fn check_args(a: &BenchArgs) -> Result<(Vec<Variant>, Vec<f64>), String> {
 /// Creates (if needed, with its missing parents, as `mkdir -p`) and checks a folder for
 /// writing.
 fn folder(dir: &Path, what: &str) -> Result<(), String> {
+    if dir.exists() && !dir.is_dir() {
+        return Err(format!(
+            "{what} {}: there is a file there, not a folder",
+            crate::render::shown(dir)
+        ));
+    }
     if !dir.is_dir() {
         std::fs::create_dir_all(dir)
-            .map_err(|e| format!("{what} {}: cannot create it: {e}", dir.display()))?;
+            .map_err(|e| format!("{what} {}: cannot create it: {e}", crate::render::shown(dir)))?;
     }
     crate::render::check_output(&dir.join("probe.json"), "json")
 }
@@ -327,7 +333,7 @@ pub fn bench(a: &BenchArgs) -> Result<String, String> {
     out.push('\n');
     tonemap(&reference)
         .save(a.output.join("reference.png"))
-        .map_err(|e| format!("{}: {e}", a.output.join("reference.png").display()))?;
+        .map_err(|e| format!("{}: {e}", crate::render::shown(&a.output.join("reference.png"))))?;
 
     // Every run goes through the library's renderer, with a covariance guide traced here
     // (its time is added to every covariance run that reads it: not to `cov` followed by a
@@ -443,7 +449,7 @@ pub fn bench(a: &BenchArgs) -> Result<String, String> {
                 title: &title,
             },
         )
-        .map_err(|e| format!("{}: {e}", p.display()))?;
+        .map_err(|e| format!("{}: {e}", crate::render::shown(&p)))?;
     }
     let strip = a.output.join("strip.png");
     let (target, picked) = write_strip(&strip, &images, &reference)?;
@@ -560,7 +566,7 @@ fn write_results(dir: &Path, rows: &[Row], uniform: &[(f64, f64)], at: AtError) 
         );
     }
     let p = dir.join("results.csv");
-    std::fs::write(&p, csv).map_err(|e| format!("{}: {e}", p.display()))?;
+    std::fs::write(&p, csv).map_err(|e| format!("{}: {e}", crate::render::shown(&p)))?;
     let fit = fit_loglog(uniform).map(|(a, b)| serde_json::json!({ "log_relmse_at_1s": a, "slope": b }));
     let json = serde_json::json!({
         "units": { "seconds": "wall-clock s", "relmse": "mean over pixels and channels of (I-R)^2/(R^2+0.01)" },
@@ -578,7 +584,7 @@ fn write_results(dir: &Path, rows: &[Row], uniform: &[(f64, f64)], at: AtError) 
         &p,
         serde_json::to_string_pretty(&json).map_err(|e| e.to_string())?,
     )
-    .map_err(|e| format!("{}: {e}", p.display()))
+    .map_err(|e| format!("{}: {e}", crate::render::shown(&p)))
 }
 
 /// Log-axis tick labels at 1, 2 and 5 of each decade only (the other grid lines unlabelled).
@@ -700,7 +706,7 @@ fn write_strip(
             cov_render::output::error_map(img, reference)
                 .map_err(|e| e.to_string())?
                 .save(&err)
-                .map_err(|e| format!("{}: {e}", err.display()))?;
+                .map_err(|e| format!("{}: {e}", crate::render::shown(&err)))?;
         }
     }
     panels.push(("reference".into(), String::new(), reference));
@@ -746,6 +752,7 @@ fn write_strip(
             i64::from(band),
         );
     }
-    pic.save(path).map_err(|e| format!("{}: {e}", path.display()))?;
+    pic.save(path)
+        .map_err(|e| format!("{}: {e}", crate::render::shown(&path)))?;
     Ok((target, picked.join(", ")))
 }

@@ -240,7 +240,8 @@ pub fn plot(e: &Evaluation, name: &str, out: &std::path::Path) -> Result<String,
         root.present().map_err(|e| e.to_string())?;
     }
     let img = image::RgbImage::from_raw(w, h, buf).ok_or("image buffer size")?;
-    img.save(out).map_err(|e| format!("{}: {e}", out.display()))?;
+    img.save(out)
+        .map_err(|e| format!("{}: {e}", crate::render::shown(&out)))?;
     Ok(format!(
         "{} panels of {} steps ({}), {}×{} px",
         count,

@@ -483,9 +483,15 @@ fn render_one(
         .iter()
         .all(|p| p.x == 0.0 && p.y == 0.0 && p.z == 0.0)
     {
-        out.push_str(
-            "warning: the image is black: no light reached the camera (a Rect light emits on the side of edge_u × edge_v)\n",
-        );
+        // The likely causes this scene can have: a light facing away, or no radiance.
+        let rect = world
+            .lights
+            .iter()
+            .any(|l| matches!(l, cov_render::world::Light::Rect { .. }));
+        out.push_str(&format!(
+            "warning: the image is black: no light reached the camera (is every light's radiance 0, or does the camera see only what no light reaches?{})\n",
+            if rect { " A Rect light emits on the side of edge_u × edge_v." } else { "" }
+        ));
     }
     let mut written = vec![output.to_path_buf(), png, aov];
     if renderer.maps().is_some() {
@@ -725,7 +731,7 @@ pub fn check(a: &CheckArgs) -> Result<String, String> {
     let agreement = cov_render::validate::compare(&ref_a, &ref_b, &maps, filter);
     if let Some(j) = &a.json {
         let text = serde_json::to_string_pretty(&agreement).map_err(|e| e.to_string())?;
-        std::fs::write(j, text).map_err(|e| format!("{}: {e}", j.display()))?;
+        std::fs::write(j, text).map_err(|e| format!("{}: {e}", crate::render::shown(&j)))?;
     }
     let n = agreement.tiles.len();
     // A rank correlation needs two tiles with detail; fewer, and it is not defined.

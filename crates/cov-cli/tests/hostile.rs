@@ -299,3 +299,18 @@ fn outputs_never_overwrite_inputs() {
     .collect();
     assert!(before == after, "an input changed");
 }
+
+/// A file name with a line break in it is shown escaped: the error stays one line.
+#[test]
+fn a_line_break_in_a_path_stays_escaped() {
+    for args in [
+        vec!["eval", "no\nsuch.ron"],
+        vec!["render", "examples/scenes/cornell.ron", "-o", "no\nsuch/x.exr"],
+    ] {
+        let o = covtrace(&args);
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "{err}");
+        assert_eq!(err.trim_end().lines().count(), 1, "{err}");
+        assert!(err.contains("no\\nsuch"), "{err}");
+    }
+}

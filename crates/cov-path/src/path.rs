@@ -186,7 +186,7 @@ impl Path {
         let name = if stdin {
             "<stdin>".to_string()
         } else {
-            file.display().to_string()
+            cov_core::one_line(&file.display().to_string())
         };
         let io = |message: String| PathError::Io {
             file: name.clone(),

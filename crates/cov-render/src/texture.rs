@@ -60,6 +60,10 @@ fn lum(c: [f32; 3]) -> f64 {
 /// Checks that a procedural texture's parameter `what` (a count of features across it)
 /// is 1 to its `size` in texels.
 fn per_texture(what: &str, v: u32, size: u32) -> Result<(), String> {
+    // The size itself first: a count cannot be judged against a size out of range.
+    if size == 0 || size > MAX_TEXTURE_SIDE {
+        return Err(format!("size must be 1 to {MAX_TEXTURE_SIDE} texels, got {size}"));
+    }
     if v == 0 || v > size {
         return Err(format!(
             "{what} must be 1 to the texture's size ({size}), got {v}"
@@ -115,6 +119,7 @@ impl TextureMap {
         size: u32,
         repeat: DVec2,
     ) -> Result<TextureMap, String> {
+        per_texture("checks", 1, size)?;
         if checks.0 == 0 || checks.1 == 0 || checks.0 > size || checks.1 > size {
             return Err(format!(
                 "checks must be 1 to the texture's size ({size}) along each side, got ({}, {})",

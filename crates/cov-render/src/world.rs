@@ -474,6 +474,9 @@ fn camera(c: &CameraDesc) -> Result<Camera, Failure> {
     }
     let forward = look.normalize();
     let up0 = c.up.as_ref().map_or(DVec3::Y, |u| v(u.value));
+    if let Some(u) = c.up.as_ref().filter(|_| up0 == DVec3::ZERO) {
+        return Err((u.ordinal, "`up` is the zero vector: it gives no direction".into()));
+    }
     let right = forward.cross(up0);
     if right.length() <= 1e-12 {
         let o = c.up.as_ref().map_or(c.look_at.ordinal, |u| u.ordinal);

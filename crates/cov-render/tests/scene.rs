@@ -275,6 +275,11 @@ fn what_single_precision_cannot_hold_is_refused() {
             "focal_length must be 1e-9 to 1e6 m, got 1e-300",
         ),
         (
+            ("LENS", ", up: (0.0, 0.0, 0.0)"),
+            "2:103",
+            "`up` is the zero vector",
+        ),
+        (
             ("LENS", ", shutter: (open: 0.0, close: 1e-160)"),
             "2:127",
             "the shutter must stay open 1e-15 to 1e6 s (close − open), got 1e-160",
@@ -397,6 +402,16 @@ fn small_inputs_cannot_ask_for_unbounded_work() {
                 .collect::<Vec<_>>()
                 .join(", ")
         ),
+    );
+    // A texture's size out of range is said before what depends on it.
+    let zero = BASE.replace(
+        "    materials:",
+        "    textures: { \"t\": Checker(checks: (2, 2), a: (1.0, 1.0, 1.0), b: (0.0, 0.0, 0.0), size: 0) },\n    materials:",
+    );
+    let e = error(&scene_from(&zero));
+    assert!(
+        e.contains("texture `t`: size must be 1 to 4096 texels, got 0"),
+        "{e}"
     );
     let e = error(&scene_from(&big));
     assert!(
