@@ -753,6 +753,6 @@ fn write_strip(
         );
     }
     pic.save(path)
-        .map_err(|e| format!("{}: {e}", crate::render::shown(&path)))?;
+        .map_err(|e| format!("{}: {e}", crate::render::shown(path)))?;
     Ok((target, picked.join(", ")))
 }

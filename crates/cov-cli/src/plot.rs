@@ -241,7 +241,7 @@ pub fn plot(e: &Evaluation, name: &str, out: &std::path::Path) -> Result<String,
     }
     let img = image::RgbImage::from_raw(w, h, buf).ok_or("image buffer size")?;
     img.save(out)
-        .map_err(|e| format!("{}: {e}", crate::render::shown(&out)))?;
+        .map_err(|e| format!("{}: {e}", crate::render::shown(out)))?;
     Ok(format!(
         "{} panels of {} steps ({}), {}×{} px",
         count,
