@@ -240,16 +240,15 @@ fn outputs_never_overwrite_inputs() {
         .find(|p| p.extension().is_some_and(|x| x == "png"))
         .expect("a PNG texture");
     let tex_exr = texture.with_extension("exr");
-    let before: Vec<Vec<u8>> = [
-        texture.clone(),
+    let inputs = [
+        texture,
         dir.join("scene.cov.json"),
         dir.join("cornell.ron"),
         dir.join("demo.png"),
         dir.join("rb/results.csv"),
-    ]
-    .iter()
-    .map(|p| std::fs::read(p).expect("input"))
-    .collect();
+    ];
+    let read = || -> Vec<Vec<u8>> { inputs.iter().map(|p| std::fs::read(p).expect("input")).collect() };
+    let before = read();
     let small = ["--size", "32x24", "--spp", "1"];
     let runs: Vec<Vec<String>> = vec![
         vec![
@@ -287,17 +286,7 @@ fn outputs_never_overwrite_inputs() {
             "{args:?}: {err}"
         );
     }
-    let after: Vec<Vec<u8>> = [
-        texture,
-        dir.join("scene.cov.json"),
-        dir.join("cornell.ron"),
-        dir.join("demo.png"),
-        dir.join("rb/results.csv"),
-    ]
-    .iter()
-    .map(|p| std::fs::read(p).expect("input"))
-    .collect();
-    assert!(before == after, "an input changed");
+    assert!(before == read(), "an input changed");
 }
 
 /// A file name with a line break in it is shown escaped: the error stays one line.
