@@ -327,7 +327,7 @@ pub fn bench(a: &BenchArgs) -> Result<String, String> {
     };
     // The runs' settings checked against the scene (`--parts` against its rows) before
     // the reference, which may take minutes.
-    Renderer::new(&world, settings(Variant::UNIFORM, budgets[0], 1)).map_err(|e| e.to_string())?;
+    Renderer::new(&world, settings(Variant::UNIFORM, budgets[0], 1)).map_err(crate::render::said)?;
     let (reference, line) = reference(a, &world, &text, &cache)?;
     out.push_str(&line);
     out.push('\n');
@@ -339,7 +339,7 @@ pub fn bench(a: &BenchArgs) -> Result<String, String> {
     // (its time is added to every covariance run that reads it: not to `cov` followed by a
     // denoiser below 3 spp, which has no pilot, `cov_render::renderer::reads_covariance`).
     let run = |m: Variant, budget: f64, guide: Option<&Guide>, seed: u64| -> Result<Rendered, String> {
-        let mut r = Renderer::new(&world, settings(m, budget, seed)).map_err(|e| e.to_string())?;
+        let mut r = Renderer::new(&world, settings(m, budget, seed)).map_err(crate::render::said)?;
         if let Some(g) = guide {
             r = r.with_guide(g.clone()).map_err(|e| e.to_string())?;
         }

@@ -270,6 +270,17 @@ pub fn check_output(out: &Path, ext: &str) -> Result<(), String> {
     Ok(())
 }
 
+/// A renderer's error as the command line says it: a setting is named by its option
+/// (`--cov-depth`, not `cov_depth`).
+pub fn said(e: cov_render::RenderError) -> String {
+    match e {
+        cov_render::RenderError::Setting { name, expected, got } => {
+            format!("--{} must be {expected}, got {got}", name.replace('_', "-"))
+        }
+        e => e.to_string(),
+    }
+}
+
 /// A path as an error shows it: on one line, shortened ([`cov_render::echo`]).
 pub fn shown(p: &Path) -> String {
     cov_render::echo(&p.display().to_string())
@@ -375,22 +386,21 @@ pub fn run(a: &RenderArgs) -> Result<String, String> {
     }
     let world = load(&a.scene, a.size)?;
     let index = a.part.map_or(1, |p| p.index);
-    cov_render::renderer::part_rows(world.camera.height, index, settings.parts)
-        .map_err(|e| format!("--{e}"))?;
+    cov_render::renderer::part_rows(world.camera.height, index, settings.parts).map_err(said)?;
     match (a.frame, a.frames) {
         (_, Some((first, last))) => {
             let mut world = world;
             let mut out = String::new();
             for k in first..=last {
                 // One scene, retimed for each frame.
-                world = world.at_frame(k).map_err(|e| e.to_string())?;
+                world = world.at_frame(k).map_err(said)?;
                 out.push_str(&format!("frame {k}:\n"));
                 out.push_str(&render_one(a, &settings, &world, &frame_path(&a.output, k))?);
             }
             Ok(out)
         }
         (k, None) => {
-            let world = world.at_frame(k.unwrap_or(0)).map_err(|e| e.to_string())?;
+            let world = world.at_frame(k.unwrap_or(0)).map_err(said)?;
             render_one(a, &settings, &world, &a.output)
         }
     }
@@ -420,7 +430,7 @@ fn render_one(
         world.geometry.len(),
         world.lights.len(),
     );
-    let mut renderer = Renderer::new(world, settings.clone()).map_err(|e| e.to_string())?;
+    let mut renderer = Renderer::new(world, settings.clone()).map_err(said)?;
     let (b, start) = match a.time {
         None => (bar(renderer.progress_len(), "rendering"), None),
         Some(t) => (seconds_bar(t), Some(std::time::Instant::now())),
@@ -512,7 +522,7 @@ fn render_part(
     part: Part,
     output: &Path,
 ) -> Result<String, String> {
-    let mut renderer = Renderer::new(world, settings.clone()).map_err(|e| e.to_string())?;
+    let mut renderer = Renderer::new(world, settings.clone()).map_err(said)?;
     let b = bar(
         renderer.part_progress_len(part).map_err(|e| e.to_string())?,
         "rendering",

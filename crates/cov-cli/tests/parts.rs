@@ -142,7 +142,7 @@ fn bad_part_options_get_one_line() {
             "--part and --time exclude each other",
         ),
         (vec!["--frames", "3..1"], "--frames must be A..B"),
-        (vec!["--frame", "2000000"], "frame must be 0 to 1000000"),
+        (vec!["--frame", "2000000"], "--frame must be 0 to 1000000"),
     ] {
         let mut a = vec!["render", SCENE, "-o", s(&out_file)];
         a.extend(args);
