@@ -752,7 +752,7 @@ pub fn check(a: &CheckArgs) -> Result<String, String> {
          predicted / measured bandwidth (median over tiles with detail): {}\n\
          rank correlation (Spearman) over tiles with detail: {}\n\
          for comparison: predicted against the variation's bandwidth alone (mean removed): {}; the references' own contrast against the measurement: {}\n\
-         under-sampled tiles (predicted < half the measured bandwidth): {:.1}% of tiles with detail",
+         under-sampled tiles (predicted < half the measured bandwidth): {} of tiles with detail",
         cov_render::echo(&a.scene.display().to_string()),
         a.ref_spp,
         a.cov_paths,
@@ -761,7 +761,11 @@ pub fn check(a: &CheckArgs) -> Result<String, String> {
         fmt_num(defined(agreement.rank_correlation)),
         fmt_num(defined(agreement.variation_correlation)),
         fmt_num(defined(agreement.contrast_correlation)),
-        100.0 * agreement.undersampled,
+        if agreement.detail_tiles > 0 {
+            format!("{:.1}%", 100.0 * agreement.undersampled)
+        } else {
+            "n/a (none)".to_string()
+        },
         t = cov_render::validate::T,
     ))
 }
