@@ -65,7 +65,7 @@ pub struct BenchArgs {
     #[arg(long, default_value_t = 1024)]
     pub ref_spp: u32,
     /// Covariance paths per block of the covariance grid.
-    #[arg(long, default_value_t = 1)]
+    #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..=i64::from(cov_render::covpass::MAX_COV_PATHS)))]
     pub cov_paths: u32,
     /// Side of the covariance grid's blocks (px): `cov_paths` paths per block of
     /// `stride × stride` pixels (1, 2, 4, 8 or 16).
@@ -73,7 +73,7 @@ pub struct BenchArgs {
     pub cov_stride: u32,
     /// Surface vertices each covariance path follows: 1 (camera → hit → light; the
     /// default, measured better) to 2 (every vertex the path tracer samples).
-    #[arg(long, default_value_t = cov_render::DEFAULT_DEPTH)]
+    #[arg(long, default_value_t = cov_render::DEFAULT_DEPTH, value_parser = clap::value_parser!(u32).range(1..=i64::from(cov_render::covpass::MAX_DEPTH)))]
     pub cov_depth: u32,
     /// Render at this size instead of the scene's (`WIDTHxHEIGHT`).
     #[arg(long, value_parser = parse_size)]
@@ -83,7 +83,7 @@ pub struct BenchArgs {
     pub seed: u64,
     /// Split each run's allocation into this many parts of the rows, as a render in parts
     /// does (`covtrace render --parts N`): what splitting costs in error.
-    #[arg(long, default_value_t = 1)]
+    #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..=i64::from(cov_render::renderer::MAX_PARTS)))]
     pub parts: u32,
     /// Output folder (created with its missing parents).
     #[arg(short, long, default_value = "render-bench")]
@@ -93,7 +93,7 @@ pub struct BenchArgs {
     pub cache: Option<PathBuf>,
     /// Renders each run this many times with different seeds: errors are averaged, the
     /// fastest time is kept (1 to 10).
-    #[arg(long, default_value_t = 1)]
+    #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..=10))]
     pub repeat: u32,
 }
 

@@ -42,14 +42,14 @@ pub struct RenderArgs {
     #[arg(short, long, default_value = "render.exr")]
     pub output: PathBuf,
     /// Covariance paths per block of the covariance grid.
-    #[arg(long, default_value_t = 1)]
+    #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..=i64::from(cov_render::covpass::MAX_COV_PATHS)))]
     pub cov_paths: u32,
     /// Side of the covariance grid's blocks (px): 1, 2, 4, 8 or 16.
     #[arg(long, default_value_t = 4)]
     pub cov_stride: u32,
     /// Surface vertices each covariance path follows: 1 (camera → hit → light; the
     /// default, measured better) to 2 (every vertex the path tracer samples).
-    #[arg(long, default_value_t = cov_render::DEFAULT_DEPTH)]
+    #[arg(long, default_value_t = cov_render::DEFAULT_DEPTH, value_parser = clap::value_parser!(u32).range(1..=i64::from(cov_render::covpass::MAX_DEPTH)))]
     pub cov_depth: u32,
     /// Seed of the random numbers (the image does not depend on the thread count).
     #[arg(long, default_value_t = 1)]
@@ -65,10 +65,10 @@ pub struct RenderArgs {
     /// Split the allocation of samples into N parts of the rows, each spending its own
     /// pixels' share of the budget, as a render in N parts does (default 1: the budget is
     /// spread over the whole image).
-    #[arg(long)]
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=i64::from(cov_render::renderer::MAX_PARTS)))]
     pub parts: Option<u32>,
     /// Render frame K of an animation: the shutter moves by K / the scene's frame_rate.
-    #[arg(long, conflicts_with = "frames")]
+    #[arg(long, conflicts_with = "frames", value_parser = clap::value_parser!(u32).range(0..=i64::from(cov_render::world::MAX_FRAME)))]
     pub frame: Option<u32>,
     /// Render frames A to B (`A..B`, B included), each to OUT with its number before the
     /// extension (`out.0007.exr`).
@@ -652,11 +652,11 @@ pub struct CheckArgs {
     #[arg(long, default_value_t = 256)]
     pub ref_spp: u32,
     /// Covariance paths per pixel.
-    #[arg(long, default_value_t = 8)]
+    #[arg(long, default_value_t = 8, value_parser = clap::value_parser!(u32).range(1..=i64::from(cov_render::covpass::MAX_COV_PATHS)))]
     pub cov_paths: u32,
     /// Surface vertices each covariance path follows: 1 (camera → hit → light; the
     /// default, measured better) to 2 (every vertex the path tracer samples).
-    #[arg(long, default_value_t = cov_render::DEFAULT_DEPTH)]
+    #[arg(long, default_value_t = cov_render::DEFAULT_DEPTH, value_parser = clap::value_parser!(u32).range(1..=i64::from(cov_render::covpass::MAX_DEPTH)))]
     pub cov_depth: u32,
     /// Render at this size instead of the scene's (`WIDTHxHEIGHT`).
     #[arg(long, value_parser = parse_size)]

@@ -136,13 +136,17 @@ fn bad_part_options_get_one_line() {
             vec!["--part", "1/2", "--parts", "3"],
             "--part 1/2 renders a part of 2 parts, but --parts is 3",
         ),
-        (vec!["--parts", "0"], "--parts must be 1 to 512"),
+        (vec!["--parts", "0"], "'--parts <PARTS>': 0 is not in 1..=512"),
+        (
+            vec!["--parts", "9", "--size", "40x64"],
+            "--parts must be 1 to 4 for this image (its 64 rows make 4 tile rows of 16), with 1 ≤ part ≤ parts, got 9",
+        ),
         (
             vec!["--part", "1/2", "--time", "1"],
             "--part and --time exclude each other",
         ),
         (vec!["--frames", "3..1"], "--frames must be A..B"),
-        (vec!["--frame", "2000000"], "--frame must be 0 to 1000000"),
+        (vec!["--frame", "2000000"], "2000000 is not in 0..=1000000"),
     ] {
         let mut a = vec!["render", SCENE, "-o", s(&out_file)];
         a.extend(args);

@@ -614,7 +614,11 @@ pub fn part_rows(height: u32, index: u32, parts: u32) -> Result<Range<u32>, Rend
             format!(
                 "1 to {rows} for this image (its {height} rows make {rows} tile rows of {tile}), with 1 ≤ part ≤ parts"
             ),
-            format!("part {index} of {parts}"),
+            if parts > rows {
+                format!("{parts}")
+            } else {
+                format!("part {index} of {parts}")
+            },
         ));
     }
     let at = |k: u32| (u64::from(k) * u64::from(rows) / u64::from(parts)) as u32 * tile;
