@@ -281,14 +281,8 @@ pub fn bench(a: &BenchArgs) -> Result<String, String> {
     folder(&cache, "cache folder")?;
     let world = crate::render::load(&a.scene, a.size)?;
     // The scene's text keys the cached reference; read as the scene was, within its bound.
-    let text = {
-        use std::io::Read;
-        let mut t = Vec::new();
-        std::fs::File::open(&a.scene)
-            .and_then(|f| f.take(cov_render::scene::MAX_SCENE_BYTES).read_to_end(&mut t))
-            .map_err(|e| format!("{}: {e}", crate::render::shown(&a.scene)))?;
-        t
-    };
+    let text = cov_render::world::read_bounded(&a.scene, cov_render::scene::MAX_SCENE_BYTES, "scene")
+        .map_err(|e| format!("{}: {e}", crate::render::shown(&a.scene)))?;
     // What the run writes in the output folder must not be what it reads.
     let mut written: Vec<std::path::PathBuf> = [
         "results.csv",

@@ -57,13 +57,19 @@ fn lum(c: [f32; 3]) -> f64 {
     crate::material::luminance(DVec3::new(c[0] as f64, c[1] as f64, c[2] as f64))
 }
 
-/// Checks that a procedural texture's parameter `what` (a count of features across it)
-/// is 1 to its `size` in texels.
-fn per_texture(what: &str, v: u32, size: u32) -> Result<(), String> {
-    // The size itself first: a count cannot be judged against a size out of range.
+/// Checks a procedural texture's side `size`: 1 to [`MAX_TEXTURE_SIDE`] texels.
+fn checked_size(size: u32) -> Result<(), String> {
     if size == 0 || size > MAX_TEXTURE_SIDE {
         return Err(format!("size must be 1 to {MAX_TEXTURE_SIDE} texels, got {size}"));
     }
+    Ok(())
+}
+
+/// Checks that a procedural texture's parameter `what` (a count of features across it)
+/// is 1 to its `size` in texels, the size itself first ([`checked_size`]): a count cannot
+/// be judged against a size out of range.
+fn per_texture(what: &str, v: u32, size: u32) -> Result<(), String> {
+    checked_size(size)?;
     if v == 0 || v > size {
         return Err(format!(
             "{what} must be 1 to the texture's size ({size}), got {v}"
@@ -119,7 +125,7 @@ impl TextureMap {
         size: u32,
         repeat: DVec2,
     ) -> Result<TextureMap, String> {
-        per_texture("checks", 1, size)?;
+        checked_size(size)?;
         if checks.0 == 0 || checks.1 == 0 || checks.0 > size || checks.1 > size {
             return Err(format!(
                 "checks must be 1 to the texture's size ({size}) along each side, got ({}, {})",
@@ -227,11 +233,9 @@ impl TextureMap {
         Self::from_rgb(w, h, rgb, repeat)
     }
 
-    /// Rasterises `f(u, v)` (u, v in [0, 1), sampled at texel centres) on `size²` texels.
+    /// Rasterises `f(u, v)` (u, v in [0, 1), sampled at texel centres) on `size²` texels;
+    /// its callers checked `size` ([`checked_size`]).
     fn raster(size: u32, repeat: DVec2, f: impl Fn(f64, f64) -> DVec3) -> Result<TextureMap, String> {
-        if size == 0 || size > MAX_TEXTURE_SIDE {
-            return Err(format!("size must be 1 to {MAX_TEXTURE_SIDE} texels, got {size}"));
-        }
         let n = size as usize;
         let mut rgb = Vec::with_capacity(n * n);
         for row in 0..n {

@@ -393,20 +393,7 @@ impl World {
             at: None,
             message,
         };
-        let meta = std::fs::metadata(path).map_err(|e| err(e.to_string()))?;
-        if meta.len() > MAX_SCENE_BYTES {
-            return Err(err(format!(
-                "the file is {} bytes; scene files are read up to {MAX_SCENE_BYTES} bytes",
-                meta.len()
-            )));
-        }
-        // Read up to one byte past the bound: a device or a pipe reports no length.
-        let bytes = read_at_most(path, MAX_SCENE_BYTES).map_err(|e| err(e.to_string()))?;
-        if bytes.len() as u64 > MAX_SCENE_BYTES {
-            return Err(err(format!(
-                "the file is more than {MAX_SCENE_BYTES} bytes; scene files are read up to that"
-            )));
-        }
+        let bytes = read_bounded(path, MAX_SCENE_BYTES, "scene").map_err(err)?;
         let text = String::from_utf8(bytes).map_err(|e| {
             let (line, col) = cov_core::utf8_error_at(e.as_bytes()).map_or((1, 1), |(l, c, _)| (l, c));
             SceneError {
@@ -616,7 +603,8 @@ pub const MAX_SCENE_TEXELS: usize = 2 * 4096 * 4096;
 pub const MAX_OBJ_BYTES: u64 = 350 << 20;
 
 /// `Err` at `at` if the scene's textures up to `name` hold more than
-/// [`MAX_SCENE_TEXELS`] (`texels`); `made`: counted after the texture was made, not before.
+/// [`MAX_SCENE_TEXELS`] (`texels`); `made`: counted once the texture was made (an
+/// image, whose size its file tells), not before.
 fn too_many_texels(texels: usize, name: &At<String>, at: u32, made: bool) -> Result<(), Failure> {
     if texels <= MAX_SCENE_TEXELS {
         return Ok(());
@@ -631,14 +619,29 @@ fn too_many_texels(texels: usize, name: &At<String>, at: u32, made: bool) -> Res
     ))
 }
 
-/// The first `limit + 1` bytes of `path` at most (a file, or a device or pipe whose
-/// length is not known beforehand): more than `limit` means the input is too large.
-fn read_at_most(path: &Path, limit: u64) -> std::io::Result<Vec<u8>> {
+/// The bytes of `path`, a `what` file (scene, OBJ), if at most `limit`: a file's length is
+/// checked first, and the read stops one byte past `limit` whatever the length says (a
+/// device or a pipe reports none).
+///
+/// # Errors
+/// An unreadable file, or one longer than `limit`, in one line.
+pub fn read_bounded(path: &Path, limit: u64, what: &str) -> Result<Vec<u8>, String> {
     use std::io::Read;
+    let len = std::fs::metadata(path).map_err(|e| e.to_string())?.len();
+    if len > limit {
+        return Err(format!(
+            "the file is {len} bytes; {what} files are read up to {limit} bytes"
+        ));
+    }
     let mut bytes = Vec::new();
-    std::fs::File::open(path)?
-        .take(limit + 1)
-        .read_to_end(&mut bytes)?;
+    std::fs::File::open(path)
+        .and_then(|f| f.take(limit + 1).read_to_end(&mut bytes))
+        .map_err(|e| e.to_string())?;
+    if bytes.len() as u64 > limit {
+        return Err(format!(
+            "the file is more than {limit} bytes; {what} files are read up to that"
+        ));
+    }
     Ok(bytes)
 }
 
@@ -661,8 +664,7 @@ fn textures(desc: &SceneFile, dir: &Path) -> Result<(Vec<TextureMap>, Vec<String
         texels += side * side;
         too_many_texels(texels, name, t.ordinal, false)?;
     }
-    // Then every texture's, images included, as they are made.
-    let mut texels = 0usize;
+    // Then each image's, on top, as it is decoded.
     for (name, t) in &desc.textures {
         let rep = |r: &Option<(crate::scene::Positive, crate::scene::Positive)>| {
             r.map_or(DVec2::ONE, |(a, b)| DVec2::new(a.0, b.0))
@@ -728,9 +730,11 @@ fn textures(desc: &SceneFile, dir: &Path) -> Result<(Vec<TextureMap>, Vec<String
             ),
         };
         let map = map.map_err(|e| (at, format!("texture `{}`: {e}", crate::echo(&name.value))))?;
-        let (w, h) = map.size();
-        texels += w * h;
-        too_many_texels(texels, name, at, true)?;
+        if let TextureDesc::Image { .. } = t.value {
+            let (w, h) = map.size();
+            texels += w * h;
+            too_many_texels(texels, name, at, true)?;
+        }
         maps.push(map);
         names.push(name.value.clone());
     }
@@ -907,6 +911,9 @@ fn large_enough(desc: &SceneFile) -> Result<(), Failure> {
     let mut sizes: Vec<(&str, f64, DVec3, u32)> = Vec::new();
     // A parallelogram's two edges, at its first edge's position; the largest component
     // where the length underflows (an edge of 1e-300 m).
+    let sphere = |center: &V3, radius: &At<crate::scene::Positive>| {
+        ("sphere's radius", radius.value.0, v(*center), radius.ordinal)
+    };
     let edges = |what, corner: V3, eu: &At<V3>, ev: V3| {
         [v(eu.value), v(ev)].map(|e| (what, e.length().max(e.abs().max_element()), v(corner), eu.ordinal))
     };
@@ -918,9 +925,7 @@ fn large_enough(desc: &SceneFile) -> Result<(), Failure> {
                 edge_v,
                 ..
             } => sizes.extend(edges("Rect light's edge", *corner, edge_u, *edge_v)),
-            LightDesc::Sphere { center, radius, .. } => {
-                sizes.push(("sphere's radius", radius.value.0, v(*center), radius.ordinal))
-            }
+            LightDesc::Sphere { center, radius, .. } => sizes.push(sphere(center, radius)),
         }
     }
     for s in &desc.shapes {
@@ -931,9 +936,7 @@ fn large_enough(desc: &SceneFile) -> Result<(), Failure> {
                 edge_v,
                 ..
             } => sizes.extend(edges("Quad's edge", *corner, edge_u, *edge_v)),
-            ShapeDesc::Sphere { center, radius, .. } => {
-                sizes.push(("sphere's radius", radius.value.0, v(*center), radius.ordinal))
-            }
+            ShapeDesc::Sphere { center, radius, .. } => sizes.push(sphere(center, radius)),
             ShapeDesc::Mesh { .. } => {}
         }
     }
@@ -1075,12 +1078,7 @@ fn load_obj(path: &Path, limit: usize) -> Result<Vec<ObjTriangle>, String> {
         single_index: true,
         ..Default::default()
     };
-    let bytes = read_at_most(path, MAX_OBJ_BYTES).map_err(|e| cov_core::one_line(&e.to_string()))?;
-    if bytes.len() as u64 > MAX_OBJ_BYTES {
-        return Err(format!(
-            "the file is more than {MAX_OBJ_BYTES} bytes; OBJ files are read up to that"
-        ));
-    }
+    let bytes = read_bounded(path, MAX_OBJ_BYTES, "OBJ").map_err(|e| cov_core::one_line(&e))?;
     // Materials come from the scene: an `mtllib` line is not followed (it could name a
     // device or a pipe).
     let no_materials = |_: &Path| Ok((Vec::new(), Default::default()));
