@@ -109,9 +109,8 @@ pub struct ThickOccluderSpec {
     /// Depth of the occluder along the ray.
     #[param(unit = "m", non_negative)]
     pub depth: f64,
-    /// Number of slices. (At most 10⁴: each slice is a window and a travel, so this
-    /// bounds the work of one operator; finer slicing changes nothing measurable, since
-    /// the slices' windows add up to the occluder's.)
+    /// Number of slices, each a window and a travel. (At most 10⁴. The operator applies
+    /// them in closed form, at the same cost for any number.)
     #[param(ge = 1, le = 10_000)]
     pub slices: u32,
     /// Window std of each slice.
@@ -125,7 +124,7 @@ impl Build for ThickOccluderSpec {
         let w = window_var(&ThickOccluderSpec::STD, spec.std)?;
         Ok(ThickOccluder {
             window: Window { wx: w, wy: w },
-            step: spec.depth / f64::from(spec.slices),
+            depth: spec.depth,
             slices: spec.slices,
         })
     }

@@ -116,3 +116,75 @@ proptest::proptest! {
         proptest::prop_assert!(s[0] >= 0.0 && s[2] >= 0.0 && s[1] * s[1] <= s[0] * s[2] * (1.0 + 1e-12));
     }
 }
+
+/// `slices` windows and travels, one by one: what [`ThickOccluder`] computes in closed
+/// form.
+fn sliced<S: Spectrum>(mut s: S, depth: f64, slices: u32, std: f64) -> S {
+    let window = Window::isotropic(std).unwrap();
+    for _ in 0..slices {
+        Operator::apply(&window, &mut s).unwrap();
+        for &(p, d) in s.transverse_pairs() {
+            s.shear(p, d, -depth / f64::from(slices)).unwrap();
+        }
+    }
+    s
+}
+
+/// The largest entry of `a − b` over the largest entry of `b`.
+fn rel_diff<const N: usize>(a: &Cov<N>, b: &Cov<N>) -> f64 {
+    let scale = b.packed().iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    let diff = a
+        .packed()
+        .iter()
+        .zip(b.packed())
+        .fold(0.0f64, |m, (x, y)| m.max((x - y).abs()));
+    diff / scale
+}
+
+/// A Σ with correlations: a Gaussian of stds `stds`, travelled by `d`.
+fn start<const N: usize>(stds: [f64; N], d: f64) -> Cov<N> {
+    let mut c = Cov::<N>::gaussian(stds).unwrap();
+    for &(p, q) in c.transverse_pairs() {
+        c.shear(p, q, -d).unwrap();
+    }
+    c
+}
+
+fn closed_form_is_the_slices<const N: usize>(stds: [f64; N], d: f64, depth: f64, slices: u32, std: f64) {
+    let c = start(stds, d);
+    let op = ThickOccluder::new(depth, slices, std).unwrap();
+    let mut got = c;
+    Operator::apply(&op, &mut got).unwrap();
+    let want = sliced(c, depth, slices, std);
+    assert!(
+        rel_diff(&got, &want) < 1e-10,
+        "N={N}, {slices} slices: {got:?} vs {want:?}"
+    );
+    // The square-root form agrees too.
+    let mut f = cov_core::CovFactor::from_cov(&c);
+    Operator::apply(&op, &mut f).unwrap();
+    assert!(
+        rel_diff(&f.to_cov().unwrap(), &want) < 1e-9,
+        "N={N} factor, {slices} slices"
+    );
+}
+
+#[test]
+fn ten_thousand_slices_in_closed_form() {
+    closed_form_is_the_slices([0.2, 0.1], 0.5, 0.4, 10_000, 0.15);
+    closed_form_is_the_slices([0.2, 0.3, 0.1, 0.05], 1.0, 2.0, 10_000, 0.5);
+    closed_form_is_the_slices([0.2, 0.3, 0.1, 0.05, 0.01], 1.0, 0.0, 10_000, 0.5);
+}
+
+proptest::proptest! {
+    #![proptest_config(proptest::prelude::ProptestConfig::with_cases(64))]
+    #[test]
+    fn closed_form_matches_the_slices(
+        sx in 0.01f64..2.0, su in 0.01f64..2.0, d in -3.0f64..3.0,
+        depth in 0.0f64..5.0, slices in 1u32..200, std in 0.01f64..2.0,
+    ) {
+        closed_form_is_the_slices([sx, su], d, depth, slices, std);
+        closed_form_is_the_slices([sx, 0.7 * sx, su, 1.3 * su], d, depth, slices, std);
+        closed_form_is_the_slices([sx, 0.7 * sx, su, 1.3 * su, 0.2], d, depth, slices, std);
+    }
+}
