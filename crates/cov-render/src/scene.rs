@@ -97,6 +97,25 @@ checked!(
     NonNegative, |v| v.is_finite() && v >= 0.0, "finite and ≥ 0"
 );
 
+/// A texture's repeat `(u, v)`: how many times it tiles the surface's UV square, each
+/// finite and > 0. Read as one value, so that an error names it (a tuple's entries have
+/// no field name of their own).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Repeat(pub f64, pub f64);
+
+impl<'de> Deserialize<'de> for Repeat {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        let (u, v) = <(f64, f64)>::deserialize(d)?;
+        if [u, v].iter().all(|x| x.is_finite() && *x > 0.0) {
+            return Ok(Repeat(u, v));
+        }
+        let [u, v] = [u, v].map(cov_core::num);
+        Err(D::Error::custom(format!(
+            "each entry must be finite and > 0, got ({u}, {v})"
+        )))
+    }
+}
+
 /// A point or vector `(x, y, z)`, finite.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct V3(pub [f64; 3]);
@@ -304,7 +323,7 @@ pub enum TextureDesc {
         file: At<String>,
         /// Repeats over a unit of `u` and `v` (default 1, 1).
         #[serde(default)]
-        repeat: Option<(Positive, Positive)>,
+        repeat: Option<Repeat>,
     },
     /// A checkerboard.
     Checker {
@@ -319,7 +338,7 @@ pub enum TextureDesc {
         size: Option<u32>,
         /// Repeats over a unit of `u` and `v` (default 1, 1).
         #[serde(default)]
-        repeat: Option<(Positive, Positive)>,
+        repeat: Option<Repeat>,
     },
     /// Stripes along `v` (bands running along `u`).
     Stripes {
@@ -337,7 +356,7 @@ pub enum TextureDesc {
         size: Option<u32>,
         /// Repeats over a unit of `u` and `v` (default 1, 1).
         #[serde(default)]
-        repeat: Option<(Positive, Positive)>,
+        repeat: Option<Repeat>,
     },
     /// Smooth value noise between two colours.
     Noise {
@@ -355,7 +374,7 @@ pub enum TextureDesc {
         size: Option<u32>,
         /// Repeats over a unit of `u` and `v` (default 1, 1).
         #[serde(default)]
-        repeat: Option<(Positive, Positive)>,
+        repeat: Option<Repeat>,
     },
 }
 

@@ -666,9 +666,7 @@ fn textures(desc: &SceneFile, dir: &Path) -> Result<(Vec<TextureMap>, Vec<String
     }
     // Then each image's, on top, as it is decoded.
     for (name, t) in &desc.textures {
-        let rep = |r: &Option<(crate::scene::Positive, crate::scene::Positive)>| {
-            r.map_or(DVec2::ONE, |(a, b)| DVec2::new(a.0, b.0))
-        };
+        let rep = |r: &Option<crate::scene::Repeat>| r.map_or(DVec2::ONE, |r| DVec2::new(r.0, r.1));
         let size = |s: &Option<u32>| s.unwrap_or(DEFAULT_TEXTURE_SIZE);
         // The map, and where an error in making it points (the file name, or the texture).
         let (map, at) = match &t.value {

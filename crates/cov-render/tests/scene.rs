@@ -196,6 +196,16 @@ fn refused_values_name_their_field() {
     assert!(e.contains("`center`: a vector must be finite"), "{e}");
     let fov = scene(&[("FOV", "-1.0")]);
     assert!(error(&fov).contains("`fov`"), "{}", error(&fov));
+    // A pair's entry has no field name of its own: the pair is named.
+    let repeat = scene(&[]).replace(
+        "    materials:",
+        "    textures: { \"t\": Checker(checks: (2, 2), a: (1.0, 1.0, 1.0), b: (0.0, 0.0, 0.0), repeat: (1.0, NaN)) },\n    materials:",
+    );
+    let e = error(&repeat);
+    assert!(
+        e.contains("`repeat`: each entry must be finite and > 0, got (1, NaN)"),
+        "{e}"
+    );
 }
 
 /// What single precision cannot hold is refused where it is written: a shape or a light
