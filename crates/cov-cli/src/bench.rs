@@ -508,6 +508,11 @@ fn summary(rows: &[Row], methods: &[Variant], budgets: &[f64]) -> String {
             };
         }
         let _ = writeln!(s, "(≥: the method's smallest budget is already below that error)");
+    } else if rows.iter().any(|r| r.method == "uniform") {
+        let _ = writeln!(
+            s,
+            "\nuniform's error at its largest budget is 0 (a black reference, or an image every sample gets exactly): no equal-error time to compare"
+        );
     }
     s
 }
@@ -520,6 +525,10 @@ fn at_error(rows: &[Row], methods: &[Variant]) -> AtError {
         .filter(|r| r.method == "uniform")
         .max_by(|a, b| a.budget.total_cmp(&b.budget))?
         .relmse;
+    // No error to reach: every time would read 0 or "not reached", neither meaningful.
+    if target <= 0.0 {
+        return None;
+    }
     let times = methods
         .iter()
         .map(|m| {

@@ -120,3 +120,51 @@ fn parts_are_checked_before_the_reference() {
         "a reference was rendered first"
     );
 }
+
+/// A scene whose light emits nothing: every error is 0, so no method "reaches" anything
+/// and none is "not reached"; the report says why there is no equal-error time.
+#[test]
+fn a_black_scene_has_no_equal_error_time() {
+    let dir = common::tmp("bench", "black");
+    std::fs::create_dir_all(&dir).unwrap();
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
+    let scene = std::fs::read_to_string(root.join("examples/scenes/cornell.ron")).unwrap();
+    let black = zero_radiance(&scene);
+    let file = dir.join("black.ron");
+    std::fs::write(&file, black).unwrap();
+    let out = covtrace(&[
+        "render-bench",
+        file.to_str().unwrap(),
+        "--size",
+        "16x16",
+        "--ref-spp",
+        "4",
+        "--budgets",
+        "1,2",
+        "--methods",
+        "uniform,cov",
+        "-o",
+        dir.join("out").to_str().unwrap(),
+    ]);
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(!stdout.contains("not reached"), "{stdout}");
+    assert!(
+        stdout.contains("uniform's error at its largest budget is 0"),
+        "{stdout}"
+    );
+}
+
+/// `text` with every `radiance: (..)` made `(0.0, 0.0, 0.0)`.
+fn zero_radiance(text: &str) -> String {
+    let mut out = String::new();
+    let mut rest = text;
+    while let Some(i) = rest.find("radiance: (") {
+        let (head, tail) = rest.split_at(i + "radiance: (".len());
+        out.push_str(head);
+        out.push_str("0.0, 0.0, 0.0");
+        rest = &tail[tail.find(')').expect("a closed triple")..];
+    }
+    out.push_str(rest);
+    out
+}
