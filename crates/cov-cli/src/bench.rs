@@ -325,9 +325,8 @@ pub fn bench(a: &BenchArgs) -> Result<String, String> {
     let (reference, line) = reference(a, &world, &text, &cache)?;
     out.push_str(&line);
     out.push('\n');
-    tonemap(&reference)
-        .save(a.output.join("reference.png"))
-        .map_err(|e| format!("{}: {e}", crate::render::shown(&a.output.join("reference.png"))))?;
+    cov_render::output::save(tonemap(&reference), &a.output.join("reference.png"))
+        .map_err(|e| e.to_string())?;
 
     // Every run goes through the library's renderer, with a covariance guide traced here
     // (its time is added to every covariance run that reads it: not to `cov` followed by a
@@ -569,7 +568,7 @@ fn write_results(dir: &Path, rows: &[Row], uniform: &[(f64, f64)], at: AtError) 
         );
     }
     let p = dir.join("results.csv");
-    std::fs::write(&p, csv).map_err(|e| format!("{}: {e}", crate::render::shown(&p)))?;
+    cov_render::output::write_file(&p, csv.as_bytes()).map_err(|e| e.to_string())?;
     let fit = fit_loglog(uniform).map(|(a, b)| serde_json::json!({ "log_relmse_at_1s": a, "slope": b }));
     let json = serde_json::json!({
         "units": { "seconds": "wall-clock s", "relmse": "mean over pixels and channels of (I-R)^2/(R^2+0.01)" },
@@ -583,11 +582,8 @@ fn write_results(dir: &Path, rows: &[Row], uniform: &[(f64, f64)], at: AtError) 
         "runs": rows,
     });
     let p = dir.join("results.json");
-    std::fs::write(
-        &p,
-        serde_json::to_string_pretty(&json).map_err(|e| e.to_string())?,
-    )
-    .map_err(|e| format!("{}: {e}", crate::render::shown(&p)))
+    let text = serde_json::to_string_pretty(&json).map_err(|e| e.to_string())?;
+    cov_render::output::write_file(&p, text.as_bytes()).map_err(|e| e.to_string())
 }
 
 /// Log-axis tick labels at 1, 2 and 5 of each decade only (the other grid lines unlabelled).
@@ -706,10 +702,8 @@ fn write_strip(
             let name = dir.join(format!("{}.exr", m.name()));
             write_image(img, &name, &name.with_extension("png")).map_err(|e| e.to_string())?;
             let err = dir.join(format!("{}.error.png", m.name()));
-            cov_render::output::error_map(img, reference)
-                .map_err(|e| e.to_string())?
-                .save(&err)
-                .map_err(|e| format!("{}: {e}", crate::render::shown(&err)))?;
+            let map = cov_render::output::error_map(img, reference).map_err(|e| e.to_string())?;
+            cov_render::output::save(map, &err).map_err(|e| e.to_string())?;
         }
     }
     panels.push(("reference".into(), String::new(), reference));
@@ -755,7 +749,6 @@ fn write_strip(
             i64::from(band),
         );
     }
-    pic.save(path)
-        .map_err(|e| format!("{}: {e}", crate::render::shown(path)))?;
+    cov_render::output::save(pic, path).map_err(|e| e.to_string())?;
     Ok((target, picked.join(", ")))
 }

@@ -63,16 +63,23 @@ pub fn save<P: Picture>(
 ) -> Result<(), Box<dyn std::error::Error>> {
     register_font()?;
     let (w, h) = size;
+    // Drawn in memory, then written at once (`cov_render::output`): a failed write says
+    // why and leaves no partial file. Callers name the path; the error is the reason alone.
+    let reason = |e: cov_render::RenderError| match e {
+        cov_render::RenderError::File { message, .. } => message,
+        other => other.to_string(),
+    };
     if path.extension().is_some_and(|e| e == "svg") {
-        pic.draw(SVGBackend::new(path, (w, h)).into_drawing_area())
+        let mut text = String::new();
+        pic.draw(SVGBackend::with_string(&mut text, (w, h)).into_drawing_area())?;
+        cov_render::output::write_file(path, text.as_bytes()).map_err(reason)?;
     } else {
         let mut buf = vec![0u8; (w as usize) * (h as usize) * 3];
         pic.draw(BitMapBackend::with_buffer(&mut buf, (w, h)).into_drawing_area())?;
-        image::RgbImage::from_raw(w, h, buf)
-            .ok_or("image buffer size")?
-            .save(path)?;
-        Ok(())
+        let img = image::RgbImage::from_raw(w, h, buf).ok_or("image buffer size")?;
+        cov_render::output::save(img, path).map_err(reason)?;
     }
+    Ok(())
 }
 
 /// Colours distinct on white and in greyscale (decreasing luminance), with a marker each.
@@ -240,8 +247,7 @@ pub fn plot(e: &Evaluation, name: &str, out: &std::path::Path) -> Result<String,
         root.present().map_err(|e| e.to_string())?;
     }
     let img = image::RgbImage::from_raw(w, h, buf).ok_or("image buffer size")?;
-    img.save(out)
-        .map_err(|e| format!("{}: {e}", crate::render::shown(out)))?;
+    cov_render::output::save(img, out).map_err(|e| e.to_string())?;
     Ok(format!(
         "{} panels of {} steps ({}), {}×{} px",
         count,

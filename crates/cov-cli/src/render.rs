@@ -741,7 +741,7 @@ pub fn check(a: &CheckArgs) -> Result<String, String> {
     let agreement = cov_render::validate::compare(&ref_a, &ref_b, &maps, filter);
     if let Some(j) = &a.json {
         let text = serde_json::to_string_pretty(&agreement).map_err(|e| e.to_string())?;
-        std::fs::write(j, text).map_err(|e| format!("{}: {e}", crate::render::shown(j)))?;
+        cov_render::output::write_file(j, text.as_bytes()).map_err(|e| e.to_string())?;
     }
     let n = agreement.tiles.len();
     // A rank correlation needs two tiles with detail; fewer, and it is not defined.

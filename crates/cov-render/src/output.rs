@@ -55,8 +55,38 @@ pub fn write_image(img: &Image, exr: &Path, png: &Path) -> Result<(), RenderErro
         .collect();
     let hdr = image::Rgb32FImage::from_raw(img.width, img.height, raw)
         .ok_or_else(|| RenderError::file(exr, "the image's pixels do not match its size"))?;
-    hdr.save(exr).map_err(|e| RenderError::file(exr, e))?;
-    tonemap(img).save(png).map_err(|e| RenderError::file(png, e))
+    save(hdr, exr)?;
+    save(tonemap(img), png)
+}
+
+/// Writes `img` to `path` in the format its extension names. It is encoded in memory
+/// first, so that a write that fails (a full disk) reads as the system's error, not as
+/// the encoder's ("Format error decoding OpenExr"), and the partial file is removed.
+///
+/// # Errors
+/// An extension that names no image format; the file cannot be written.
+pub fn save(img: impl Into<image::DynamicImage>, path: &Path) -> Result<(), RenderError> {
+    let format = image::ImageFormat::from_path(path).map_err(|e| RenderError::file(path, e))?;
+    let mut bytes = std::io::Cursor::new(Vec::new());
+    img.into()
+        .write_to(&mut bytes, format)
+        .map_err(|e| RenderError::file(path, e))?;
+    write_file(path, bytes.get_ref())
+}
+
+/// Writes `bytes` to `path`; if that fails, removes what was written (a regular file).
+///
+/// # Errors
+/// The file cannot be written (the system's reason, after "cannot write").
+pub fn write_file(path: &Path, bytes: &[u8]) -> Result<(), RenderError> {
+    std::fs::write(path, bytes).map_err(|e| {
+        // A partial file is worse than none: a later run would take it for output. Only a
+        // regular file is removed (never a device such as /dev/full, nor a link's target).
+        if std::fs::symlink_metadata(path).is_ok_and(|m| m.is_file()) {
+            let _ = std::fs::remove_file(path);
+        }
+        RenderError::file(path, format!("cannot write: {e}"))
+    })
 }
 
 /// Reads a linear RGB image (an EXR written by [`write_image`]).
@@ -121,7 +151,7 @@ pub fn write_maps(
         let p = &maps.pixels[(y * w + x) as usize];
         image::Rgb(colormap(p.spp.max(1.0).ln() / hi))
     });
-    img.save(density).map_err(|e| RenderError::file(density, e))?;
+    save(img, density)?;
     let stds: Vec<f64> = maps
         .pixels
         .iter()
@@ -130,7 +160,7 @@ pub fn write_maps(
     let img = image::RgbImage::from_fn(maps.width, maps.height, |x, y| {
         image::Rgb(colormap(stds[(y * w + x) as usize] / max_filter))
     });
-    img.save(filter).map_err(|e| RenderError::file(filter, e))?;
+    save(img, filter)?;
     let data = serde_json::json!({
         "width": maps.width,
         "height": maps.height,
@@ -142,7 +172,7 @@ pub fn write_maps(
         "spp": maps.pixels.iter().map(|p| p.spp).collect::<Vec<f64>>(),
     });
     let text = serde_json::to_string(&data).map_err(|e| RenderError::file(json, e))?;
-    std::fs::write(json, text).map_err(|e| RenderError::file(json, e))
+    write_file(json, text.as_bytes())
 }
 
 /// The per-pixel relative squared error of `img` against `reference` (mean over
@@ -172,6 +202,7 @@ pub fn error_map(img: &Image, reference: &Image) -> Result<image::RgbImage, Rend
 pub fn write_aovs(aovs: &Aovs, path: &Path) -> Result<(), RenderError> {
     use exr::prelude::*;
     let (w, h) = (aovs.albedo.width as usize, aovs.albedo.height as usize);
+    let mut bytes = std::io::Cursor::new(Vec::new());
     fn at(img: &crate::film::Image, p: exr::math::Vec2<usize>) -> (f32, f32, f32) {
         let v = img.pixels[p.y() * img.width as usize + p.x()];
         (single(v.x), single(v.y), single(v.z))
@@ -194,8 +225,9 @@ pub fn write_aovs(aovs: &Aovs, path: &Path) -> Result<(), RenderError> {
         .with_layer(normal)
         .with_layer(depth)
         .write()
-        .to_file(path)
-        .map_err(|e| RenderError::file(path, e))
+        .to_buffered(&mut bytes)
+        .map_err(|e| RenderError::file(path, e))?;
+    write_file(path, bytes.get_ref())
 }
 
 #[cfg(test)]
@@ -207,5 +239,28 @@ mod tests {
         assert_eq!(super::single(1e300), f32::MAX);
         assert_eq!(super::single(f64::NEG_INFINITY), -f32::MAX);
         assert_eq!(super::single(f64::NAN), 0.0);
+    }
+
+    /// A write that fails says so with the system's reason (not an encoder's "decoding"),
+    /// leaves no partial regular file, and never removes what is not one.
+    #[test]
+    fn a_failed_write_says_why_and_leaves_nothing() {
+        let img = image::RgbImage::new(4, 4);
+        // A path under a regular file cannot be created: nothing is written.
+        let dir = std::env::temp_dir().join(format!("covtrace-output-test-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let file = dir.join("f");
+        std::fs::write(&file, b"x").unwrap();
+        let e = super::save(img, &file.join("a.png")).unwrap_err().to_string();
+        assert!(e.contains("cannot write"), "{e}");
+        assert_eq!(std::fs::read(&file).unwrap(), b"x");
+        // A full device (Linux): the reason is the system's, and the device stays.
+        let full = std::path::Path::new("/dev/full");
+        if full.exists() {
+            let e = super::write_file(full, &[0; 4096]).unwrap_err().to_string();
+            assert!(e.contains("cannot write") && e.contains("No space"), "{e}");
+            assert!(full.exists());
+        }
+        std::fs::remove_dir_all(&dir).unwrap();
     }
 }
