@@ -96,12 +96,15 @@ impl RenderError {
 }
 
 /// `Ok` if `path` is a regular file (or a link to one); otherwise what it is instead, in
-/// one line: missing, or there but not a file (a directory, a device such as `/dev/zero`).
+/// one line: missing, there but not a file (a directory, a device such as `/dev/zero`), or
+/// unreadable for another reason (a loop of links, a folder without permission).
 pub(crate) fn regular_file(path: &std::path::Path) -> Result<(), String> {
     let shown = || cov_core::one_line(&path.display().to_string());
     match std::fs::metadata(path) {
         Ok(m) if m.is_file() => Ok(()),
         Ok(_) => Err(format!("not a regular file: {}", shown())),
-        Err(_) => Err(format!("no such file: {}", shown())),
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => Err(format!("no such file: {}", shown())),
+        // A link loop, a directory on the way that cannot be searched: the system's reason.
+        Err(e) => Err(format!("{}: {}", shown(), cov_core::one_line(&e.to_string()))),
     }
 }

@@ -375,6 +375,23 @@ fn a_path_that_is_not_a_file_says_so() {
     assert!(error(&mesh).contains("not a regular file"), "{}", error(&mesh));
     let missing = scene(&[("SHAPE", r#"Mesh(obj: "missing.obj", material: "w")"#)]);
     assert!(error(&missing).contains("no such file"), "{}", error(&missing));
+    // A loop of links is there, but no file: the system's reason, not "no such file".
+    #[cfg(unix)]
+    {
+        let dir = std::env::temp_dir().join(format!("covtrace-loop-test-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let (a, b) = (dir.join("a.obj"), dir.join("b.obj"));
+        let _ = (std::fs::remove_file(&a), std::fs::remove_file(&b));
+        std::os::unix::fs::symlink(&b, &a).unwrap();
+        std::os::unix::fs::symlink(&a, &b).unwrap();
+        let looped = scene(&[(
+            "SHAPE",
+            &format!(r#"Mesh(obj: "{}", material: "w")"#, a.display()),
+        )]);
+        let e = error(&looped);
+        assert!(!e.contains("no such file") && e.contains("symbolic links"), "{e}");
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
 }
 
 /// What a few bytes of input must not make the loader do: read a device without end,
