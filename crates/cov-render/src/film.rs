@@ -111,6 +111,22 @@ pub const CUTOFF: f64 = 3.0;
 /// relative standard deviation is about `√(2/81)` = 16% (Gaussian noise); 3×3 pixels
 /// would give 47%.
 pub const SPLIT_REACH: usize = 4;
+/// **Blocks** (`BLOCKS`): the least filter std (px), per pixel of a block's side, at
+/// which a square block of pixels that share one filter splats as one source. Such a
+/// filter is wide (it was chosen where the image is smooth), and its cost is its area:
+/// a block of `b × b` pixels splats the sum of its values once, from its centre, with the
+/// filter narrowed by the spread of the block's pixels about it (`(b² − 1)/12` px² on
+/// each axis, the variance of `b` evenly spaced offsets), so that the mean splat has
+/// the filter's covariance. It costs `1/b²` of the pixels' splats. What differs is the
+/// shape: pixel `p`'s samples land around the block's centre instead of around `p`, at
+/// most `(b − 1)/√2` px away, and where the block's values vary linearly, the splat of
+/// their sum misses the first moment of that variation; both are small against a std of
+/// at least `1.5 b` px (3 px for 2×2, 6 px for 4×4). Measured on the bundled scenes in
+/// docs/render-bench.md ("Splats of blocks"). A block splats whole only where every pixel
+/// has samples and the same filter (the covariance grid gives a block of 4×4 pixels one
+/// matched filter; the edges narrow some of them).
+const BLOCK_STD: f64 = 1.5;
+
 /// Tiles rendered between two merges into the film (bounds the memory of tile results).
 const BATCH: usize = 64;
 
@@ -214,24 +230,25 @@ impl Gaussian {
 
     /// The weights of the cells at horizontal offset `lo ..= hi` and vertical offset `dy`
     /// that lie inside the [`CUTOFF`] ellipse (a row of an ellipse is one run of cells),
-    /// appended to `out`; returns the run's first offset.
+    /// appended to `out`; returns the run's first offset. The centre lies `ox` right of
+    /// offset 0 (0 for a pixel's own filter; ½ for a block's, [`BLOCKS`]).
     ///
-    /// The run is found around the row's minimum `c₀ = −q dy / p` (half-width
+    /// The run is found around the row's minimum `c₀ = ox − q dy / p` (half-width
     /// `√((cut − e(c₀)) / p)`), then corrected cell by cell against the exponent itself, so
     /// that rounding neither adds nor drops a cell that [`Gaussian::weight`] weighs
     /// otherwise. The weights come from the Gaussian's ratio recurrence,
-    /// `w(d + 1) / w(d) = exp(−½ (p (2d + 1) + 2 q dy))`, a ratio that itself changes by
+    /// `w(d + 1) / w(d) = exp(−½ (p (2(d − ox) + 1) + 2 q dy))`, a ratio that itself changes by
     /// `exp(−p)` a cell (`p`, `q`: the precision's `xx`, `xy`), run in four interleaved
     /// lanes of four-cell steps so that neighbouring cells do not wait on each other's
     /// product: two `exp` a row, two products a cell.
-    fn row_weights(&self, dy: f64, lo: i64, hi: i64, out: &mut Vec<f64>) -> i64 {
+    fn row_weights(&self, dy: f64, ox: f64, lo: i64, hi: i64, out: &mut Vec<f64>) -> i64 {
         let [p, q, rr] = self.precision;
         let e_at = |dx: i64| {
-            let dx = dx as f64;
+            let dx = dx as f64 - ox;
             p * dx * dx + 2.0 * q * dx * dy + rr * dy * dy
         };
         let cut = CUTOFF * CUTOFF;
-        let c0 = -q * dy / p;
+        let c0 = -q * dy / p + ox;
         let half = ((cut - (rr - q * q / p) * dy * dy).max(0.0) / p).sqrt();
         // `as` saturates and truncates towards zero; the corrections below do the rest.
         let mut a = ((c0 - half) as i64).clamp(lo, hi + 1);
@@ -257,7 +274,7 @@ impl Gaussian {
         let decay = self.decay;
         let mut w = [0.0; 4];
         w[0] = self.norm * (-0.5 * e_at(a)).exp();
-        let step = (-0.5 * (p * (2 * a + 1) as f64 + 2.0 * q * dy)).exp();
+        let step = (-0.5 * (p * ((2 * a + 1) as f64 - 2.0 * ox) + 2.0 * q * dy)).exp();
         let mut st = step;
         for j in 1..4 {
             w[j] = w[j - 1] * st;
@@ -329,6 +346,9 @@ const STENCIL_WEIGHTS: usize = 1 << 20;
 /// lost to the pixels in between. A filter's stencil is kept in a slot found from its
 /// precision's bits (a later filter of the same slot takes it over).
 struct Stencils {
+    /// Whether the stencils are centred half a cell right of and below their anchor
+    /// cell (a block's, [`BLOCKS`]) rather than on it.
+    shifted: bool,
     /// Per slot: the filter and the range of its rows in `rows`.
     slots: Vec<Option<(Gaussian, Range<usize>)>>,
     /// Per row of each stencil (`dy = −reach ..= reach`, [`Gaussian::reach_rows`]): the
@@ -341,9 +361,10 @@ struct Stencils {
 }
 
 impl Stencils {
-    /// No stencil yet.
-    fn new() -> Stencils {
+    /// No stencil yet; centred on their cell, or half a cell off (`shifted`).
+    fn new(shifted: bool) -> Stencils {
         Stencils {
+            shifted,
             slots: vec![None; STENCIL_SLOTS],
             rows: Vec::new(),
             weights: Vec::new(),
@@ -378,13 +399,22 @@ impl Stencils {
     fn make(&mut self, g: &Gaussian) -> Range<usize> {
         let (ri, rx) = (g.reach_rows() as i64, g.reach() as i64);
         let start = self.rows.len();
+        if self.shifted {
+            // Centred at (½, ½): rows −ri ..= ri + 1, columns −rx ..= rx + 1.
+            for dy in -ri..=ri + 1 {
+                let k = self.weights.len();
+                let first = g.row_weights(dy as f64 - 0.5, 0.5, -rx, rx + 1, &mut self.weights);
+                self.rows.push((first, k..self.weights.len()));
+            }
+            return start..self.rows.len();
+        }
         // Rows 0 ..= ri from the Gaussian; row −dy is row dy reversed (w(−x, −dy) =
         // w(x, dy), and the exponent is the same to the bit, so are its cells).
         self.rows.resize(start + 2 * ri as usize + 1, (0, 0..0));
         let rows = &mut self.rows[start..];
         for dy in 0..=ri {
             let k = self.weights.len();
-            let first = g.row_weights(dy as f64, -rx, rx, &mut self.weights);
+            let first = g.row_weights(dy as f64, 0.0, -rx, rx, &mut self.weights);
             let n = self.weights.len() - k;
             rows[(ri + dy) as usize] = (first, k..k + n);
             if dy > 0 {
@@ -395,6 +425,41 @@ impl Stencils {
             }
         }
         start..self.rows.len()
+    }
+}
+
+/// A band of rows' splat buffer: rows `top ..` of the image, `w` columns each.
+struct Band<const K: usize> {
+    buf: Vec<[f64; K]>,
+    top: usize,
+    w: usize,
+    h: usize,
+}
+
+impl<const K: usize> Band<K> {
+    /// Adds `v` weighted by the stencil `rows` of `st` anchored at cell `(x, y)` (rows
+    /// from `−(len − 1)/2`; columns as each row says), clipped to the image.
+    fn add(&mut self, st: &Stencils, rows: Range<usize>, x: i64, y: i64, v: &[f64; K]) {
+        let (w, h) = (self.w as i64, self.h as i64);
+        let rows = &st.rows[rows];
+        let first_dy = -((rows.len() as i64 - 1) / 2);
+        for (j, (first, k)) in rows.iter().enumerate() {
+            let py = y + first_dy + j as i64;
+            if py < 0 || py >= h {
+                continue;
+            }
+            // The row's run, clipped to the image's columns.
+            let c0 = (x + first).max(0);
+            let skip = (c0 - (x + first)) as usize;
+            let wts = &st.weights[(k.start + skip).min(k.end)..k.end];
+            let at = (py as usize - self.top) * self.w;
+            let row = &mut self.buf[at..at + self.w];
+            for (e, &wgt) in row[(c0.min(w)) as usize..].iter_mut().zip(wts) {
+                for j in 0..K {
+                    e[j] += v[j] * wgt;
+                }
+            }
+        }
     }
 }
 
@@ -620,35 +685,45 @@ impl Film {
                     .unwrap_or(0);
                 let top = y0.saturating_sub(reach);
                 let bottom = (y1 + reach).min(h);
-                let mut buf = vec![[0.0f64; K]; (bottom - top) * w];
-                let mut stencils = Stencils::new();
-                for y in y0..y1 {
-                    for x in 0..w {
-                        let i = y * w + x;
-                        let Some(g) = at(i) else { continue };
-                        if self.count[i] == 0 {
+                let mut band = Band {
+                    buf: vec![[0.0f64; K]; (bottom - top) * w],
+                    top,
+                    w,
+                    h,
+                };
+                let (mut own, mut shifted) = (Stencils::new(false), Stencils::new(true));
+                let mut pixel = |band: &mut Band<K>, x: usize, y: usize| {
+                    let i = y * w + x;
+                    if let Some(g) = at(i).filter(|_| self.count[i] > 0) {
+                        let rows = own.of(g);
+                        band.add(&own, rows, x as i64, y as i64, &values(i));
+                    }
+                };
+                // Blocks of 4×4 pixels (a band's rows are a multiple of 4 from its first):
+                // whole, as 2×2 quarters, or pixel by pixel (`BLOCKS`).
+                for by in (y0..y1).step_by(4) {
+                    for bx in (0..w).step_by(4) {
+                        let whole = self.block(&at, &values, bx, by, 4);
+                        if let Some((g, v)) = whole {
+                            let rows = shifted.of(&g);
+                            band.add(&shifted, rows, bx as i64 + 1, by as i64 + 1, &v);
                             continue;
                         }
-                        let v = values(i);
-                        let at = stencils.of(g);
-                        let (rows, weights) = (&stencils.rows[at], &stencils.weights);
-                        let r = rows.len() / 2;
-                        for py in y.saturating_sub(r)..(y + r + 1).min(h) {
-                            let (first, ref k) = rows[py + r - y];
-                            // The row's run, clipped to the image's columns.
-                            let c0 = (x as i64 + first).max(0) as usize;
-                            let skip = c0 as i64 - (x as i64 + first);
-                            let wts = &weights[(k.start + skip as usize).min(k.end)..k.end];
-                            let row = &mut buf[(py - top) * w..(py - top + 1) * w];
-                            for (e, &wgt) in row[c0.min(w)..].iter_mut().zip(wts) {
-                                for j in 0..K {
-                                    e[j] += v[j] * wgt;
+                        for (qx, qy) in [(bx, by), (bx + 2, by), (bx, by + 2), (bx + 2, by + 2)] {
+                            if let Some((g, v)) = self.block(&at, &values, qx, qy, 2) {
+                                let rows = shifted.of(&g);
+                                band.add(&shifted, rows, qx as i64, qy as i64, &v);
+                                continue;
+                            }
+                            for y in qy..(qy + 2).min(y1) {
+                                for x in qx..(qx + 2).min(w) {
+                                    pixel(&mut band, x, y);
                                 }
                             }
                         }
                     }
                 }
-                (top, buf)
+                (top, band.buf)
             })
             .collect();
         let mut acc = vec![[0.0; K]; w * h];
@@ -661,6 +736,44 @@ impl Film {
             }
         }
         acc
+    }
+
+    /// The block of `b × b` pixels at `(x0, y0)` as one source ([`BLOCK_STD`]): its
+    /// filter narrowed by the block's spread and the sum of its values; `None` unless the
+    /// block lies in the image, every pixel has samples and the same filter, and that
+    /// filter's smaller std is at least `BLOCK_STD · b`.
+    fn block<'a, const K: usize>(
+        &self,
+        at: &impl Fn(usize) -> Option<&'a Gaussian>,
+        values: &impl Fn(usize) -> [f64; K],
+        x0: usize,
+        y0: usize,
+        b: usize,
+    ) -> Option<(Gaussian, [f64; K])> {
+        let w = self.width as usize;
+        if x0 + b > w || y0 + b > self.height as usize {
+            return None;
+        }
+        let g = *at(y0 * w + x0)?;
+        let pixels = (y0..y0 + b).flat_map(|y| (x0..x0 + b).map(move |x| y * w + x));
+        if !pixels.clone().all(|i| self.count[i] > 0 && at(i) == Some(&g)) {
+            return None;
+        }
+        let [a, c, d] = g.cov();
+        let least = 0.5 * (a + d) - (0.25 * (a - d) * (a - d) + c * c).sqrt();
+        let side = BLOCK_STD * b as f64;
+        if least.is_nan() || least < side * side {
+            return None;
+        }
+        let spread = ((b * b - 1) as f64) / 12.0;
+        let mut v = [0.0; K];
+        for i in pixels {
+            let vi = values(i);
+            for j in 0..K {
+                v[j] += vi[j];
+            }
+        }
+        Some((Gaussian::from_cov([a - spread, c, d - spread]), v))
     }
 
     /// Per pixel, the sample variance of the luminance of its own samples (0 with fewer
@@ -923,6 +1036,8 @@ mod tests {
     /// filter at each cell: against that sum taken cell by cell with [`Gaussian::weight`],
     /// on an image of several bands, with filters wider than the image (clipped at every
     /// border), runs of pixels sharing a filter (the stencil reused) and empty pixels.
+    /// (The runs lie along rows, so no block of pixels splats as one: that is
+    /// `blocks_splat_as_their_pixels_do`.)
     #[test]
     fn splat_is_the_weighted_sum() {
         let (w, h) = (23u32, 37u32);
@@ -962,6 +1077,60 @@ mod tests {
         }
     }
 
+    /// Wide filters shared by blocks of pixels splat by blocks ([`BLOCK_STD`]): a flat
+    /// image stays flat to rounding, whatever the counts, and a smooth one (a 30% sine of
+    /// 44 px period and a ramp) is within 3e-3 of the pixel-by-pixel splat, normalised by
+    /// the splatted counts as every reconstruction divides (measured: 1.9e-3 at most, at
+    /// the borders, where the clipped filter weighs the block's shifted samples unevenly;
+    /// 4.7e-4 at most three std inside). The test fails if no block splats as one (the splat would
+    /// then equal the exact one to rounding).
+    #[test]
+    fn blocks_splat_as_their_pixels_do() {
+        let (w, h) = (42u32, 38u32);
+        let n = (w * h) as usize;
+        let field = |x: f64, y: f64| 1.0 + 0.3 * (x / 7.0).sin() + 0.2 * y / f64::from(h);
+        let mut film = Film::new(w, h);
+        for i in 0..n {
+            film.count[i] = 1 + (i * 7 % 5) as u32;
+            let (x, y) = ((i % w as usize) as f64, (i / w as usize) as f64);
+            film.reflected[i] = DVec3::splat(field(x, y)) * f64::from(film.count[i]);
+        }
+        let mut flat = film.clone();
+        for i in 0..n {
+            flat.reflected[i] = DVec3::new(0.5, 0.25, 2.0) * f64::from(flat.count[i]);
+        }
+        // 7 px: 4×4 blocks; 3.5 px: 2×2 blocks; anisotropic 8 × 4 px: 2×2 blocks.
+        for g in [
+            Gaussian::isotropic(7.0),
+            Gaussian::isotropic(3.5),
+            Gaussian::from_cov([64.0, 10.0, 16.0]),
+        ] {
+            let filter = Filter::Fixed(g);
+            let got = film.splat(&filter);
+            let (mut worst, mut inexact) = (0.0f64, 0.0f64);
+            for p in 0..n {
+                let (px, py) = ((p % w as usize) as f64, (p / w as usize) as f64);
+                let (mut s, mut c) = (0.0, 0.0);
+                for q in 0..n {
+                    let (qx, qy) = ((q % w as usize) as f64, (q / w as usize) as f64);
+                    let wq = g.weight(px - qx, py - qy);
+                    s += film.reflected[q].x * wq;
+                    c += f64::from(film.count[q]) * wq;
+                }
+                let (gs, gc) = got[p];
+                let err = (gs.x / gc - s / c).abs() / (s / c);
+                worst = worst.max(err);
+                inexact = inexact.max((gc - c).abs() / c);
+            }
+            assert!(worst < 3e-3, "{g:?}: normalised splat off by {worst:e}");
+            assert!(inexact > 1e-9, "{g:?}: no block splatted as one");
+            for (k, &(v, c)) in flat.splat(&filter).iter().enumerate() {
+                let d = (v / c - DVec3::new(0.5, 0.25, 2.0)).abs().max_element();
+                assert!(d < 1e-12, "{g:?}: pixel {k} of a flat image reads {}", v / c);
+            }
+        }
+    }
+
     /// The row weights are the weights `weight` gives, cell by cell, and no others,
     /// whatever the clipping.
     #[test]
@@ -976,11 +1145,11 @@ mod tests {
             let g = Gaussian::from_cov(c);
             let r = g.reach() as i64;
             for (lo, hi) in [(-r, r), (-3, r), (-r, 0), (2, 5), (-r, -r)] {
-                for dy in -r..=r {
+                for (dy, ox) in (-r..=r).flat_map(|dy| [(dy as f64, 0.0), (dy as f64 - 0.5, 0.5)]) {
                     let mut out = vec![7.0];
-                    let first = g.row_weights(dy as f64, lo, hi, &mut out);
+                    let first = g.row_weights(dy, ox, lo, hi, &mut out);
                     for dx in lo..=hi {
-                        let want = g.weight(dx as f64, dy as f64);
+                        let want = g.weight(dx as f64 - ox, dy);
                         let k = dx - first;
                         let got = if k >= 0 && (k as usize) + 1 < out.len() {
                             out[k as usize + 1]
@@ -989,7 +1158,7 @@ mod tests {
                         };
                         assert!(
                             (got - want).abs() <= 1e-12 * g.norm,
-                            "{c:?} [{lo}, {hi}] dy {dy} dx {dx}: {got} vs {want}"
+                            "{c:?} [{lo}, {hi}] dy {dy} ox {ox} dx {dx}: {got} vs {want}"
                         );
                     }
                     assert!(out.len() <= (hi - lo + 2).max(1) as usize && out[0] == 7.0);
@@ -998,7 +1167,7 @@ mod tests {
                 let beyond = g.reach_rows() as f64 + 1.0;
                 for dy in [beyond, -beyond] {
                     let mut out = Vec::new();
-                    g.row_weights(dy, -r, r, &mut out);
+                    g.row_weights(dy, 0.0, -r, r, &mut out);
                     assert!(out.is_empty(), "{c:?}: row {dy} has {} cells", out.len());
                 }
             }
