@@ -210,6 +210,31 @@ impl Lobe {
         }
     }
 
+    /// The lobe's spectrum variance `S = 1/(4π² var)` along `u` and `v`
+    /// ((cycles/tangent unit)²): 0 for diffuse, `∞` for a mirror (nothing to convolve),
+    /// and at most `f64::MAX` for any other (a tiny variance gives a large finite `S`).
+    /// Phong's is `exponent/(4π²)`, one product (its variance is `1/exponent`).
+    #[inline(always)]
+    pub fn spectra(&self) -> (f64, f64) {
+        let of = |var: f64| {
+            if var == 0.0 {
+                return f64::INFINITY;
+            }
+            let s = 1.0 / (FOUR_PI_SQ * var);
+            if s.is_finite() { s } else { f64::MAX }
+        };
+        match *self {
+            Lobe::Phong { exponent } => {
+                let s = exponent * (1.0 / FOUR_PI_SQ);
+                (s, s)
+            }
+            _ => {
+                let (vu, vv) = self.variances();
+                (of(vu), of(vv))
+            }
+        }
+    }
+
     /// Applies the lobe on the direction axes (rule 3). Axes with a zero variance (mirror)
     /// are skipped; an infinite variance (diffuse) uses `S = 0`.
     ///
@@ -217,26 +242,24 @@ impl Lobe {
     /// Overflow.
     #[inline(always)]
     pub fn convolve<S: Spectrum + ?Sized>(&self, cov: &mut S) -> Result<(), CovError> {
-        let (vu, vv) = self.variances();
+        let (su, sv) = self.spectra();
         // Written out per axis (not a loop over `direction_axes`), so that a caller that
         // knows its spectrum type gets each lobe with a constant axis.
-        lobe_on(cov, Axis::U, vu)?;
+        lobe_on(cov, Axis::U, su)?;
         if cov.has(Axis::V) {
-            lobe_on(cov, Axis::V, vv)?;
+            lobe_on(cov, Axis::V, sv)?;
         }
         Ok(())
     }
 }
 
-/// The lobe of primal variance `var` on direction axis `axis`: skipped for 0 (a mirror).
+/// The lobe of spectrum variance `s` ([`Lobe::spectra`]) on direction axis `axis`:
+/// skipped for `∞` (a mirror).
 #[inline(always)]
-fn lobe_on<S: Spectrum + ?Sized>(cov: &mut S, axis: Axis, var: f64) -> Result<(), CovError> {
-    if var == 0.0 {
+fn lobe_on<S: Spectrum + ?Sized>(cov: &mut S, axis: Axis, s: f64) -> Result<(), CovError> {
+    if s == f64::INFINITY {
         return Ok(());
     }
-    // S = 1/(4π² var): 0 for a diffuse lobe; a tiny var gives a large finite S.
-    let s = 1.0 / (FOUR_PI_SQ * var);
-    let s = if s.is_finite() { s } else { f64::MAX };
     cov.convolve(&[axis], &[s])
 }
 
