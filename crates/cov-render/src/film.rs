@@ -111,7 +111,7 @@ pub const CUTOFF: f64 = 3.0;
 /// relative standard deviation is about `√(2/81)` = 16% (Gaussian noise); 3×3 pixels
 /// would give 47%.
 pub const SPLIT_REACH: usize = 4;
-/// **Blocks** (`BLOCKS`): the least filter std (px), per pixel of a block's side, at
+/// **Blocks**: the least filter std (px), per pixel of a block's side, at
 /// which a square block of pixels that share one filter splats as one source. Such a
 /// filter is wide (it was chosen where the image is smooth), and its cost is its area:
 /// a block of `b × b` pixels splats the sum of its values once, from its centre, with the
@@ -231,7 +231,7 @@ impl Gaussian {
     /// The weights of the cells at horizontal offset `lo ..= hi` and vertical offset `dy`
     /// that lie inside the [`CUTOFF`] ellipse (a row of an ellipse is one run of cells),
     /// appended to `out`; returns the run's first offset. The centre lies `ox` right of
-    /// offset 0 (0 for a pixel's own filter; ½ for a block's, [`BLOCKS`]).
+    /// offset 0 (0 for a pixel's own filter; ½ for a block's, [`BLOCK_STD`]).
     ///
     /// The run is found around the row's minimum `c₀ = ox − q dy / p` (half-width
     /// `√((cut − e(c₀)) / p)`), then corrected cell by cell against the exponent itself, so
@@ -347,7 +347,7 @@ const STENCIL_WEIGHTS: usize = 1 << 20;
 /// precision's bits (a later filter of the same slot takes it over).
 struct Stencils {
     /// Whether the stencils are centred half a cell right of and below their anchor
-    /// cell (a block's, [`BLOCKS`]) rather than on it.
+    /// cell (a block's, [`BLOCK_STD`]) rather than on it.
     shifted: bool,
     /// Per slot: the filter and the range of its rows in `rows`.
     slots: Vec<Option<(Gaussian, Range<usize>)>>,
@@ -700,7 +700,7 @@ impl Film {
                     }
                 };
                 // Blocks of 4×4 pixels (a band's rows are a multiple of 4 from its first):
-                // whole, as 2×2 quarters, or pixel by pixel (`BLOCKS`).
+                // whole, as 2×2 quarters, or pixel by pixel ([`BLOCK_STD`]).
                 for by in (y0..y1).step_by(4) {
                     for bx in (0..w).step_by(4) {
                         let whole = self.block(&at, &values, bx, by, 4);
