@@ -62,10 +62,15 @@ fn scenes(c: &mut Criterion) {
 /// The guard's stages at the renderer's defaults (one covariance path per 4×4 block), on
 /// a film of 4 samples per pixel (a 16-spp render's pilot), one thread, beside the path
 /// tracing of those 4 samples: what the guard costs relative to the sampling it directs.
+/// Cornell also at 512×384, where its filters are four times as wide in pixels (a
+/// splat's cost is its area; wide filters splat by blocks, `film::BLOCK_STD`).
 fn guard(c: &mut Criterion) {
     let pool = one_thread();
-    let (w, h) = (128, 96);
-    for name in ["cornell", "chess"] {
+    for (name, (w, h)) in [
+        ("cornell", (128, 96)),
+        ("chess", (128, 96)),
+        ("cornell", (512, 384)),
+    ] {
         let world = scene(name, w, h);
         let maps = covariance_maps(&world, 1, 4, 1, None).expect("maps");
         let guide = Guide::new(&maps, 0.0);
@@ -77,7 +82,7 @@ fn guard(c: &mut Criterion) {
         };
         let film = pool.install(sample);
         let cands = candidates(&guide, 0..h);
-        let mut g = c.benchmark_group(format!("guard/{name}"));
+        let mut g = c.benchmark_group(format!("guard/{name}/{w}x{h}"));
         g.sample_size(10);
         g.bench_function("path tracing, 4 spp", |b| {
             b.iter(|| pool.install(|| black_box(sample())))
