@@ -11,9 +11,10 @@
 //!
 //! 1. the emitter as a Gaussian window of the light's size ([`crate::world::Light::window_std`]),
 //!    constant in angle and time, seen from the vertex through `Unproject(cos_l)`;
-//! 2. travel to the vertex, with a `BlockerEdge` where auxiliary shadow rays to other
-//!    points of the light are blocked (the distance from the path to the nearest blocker
-//!    hit, at the blocker's depth);
+//! 2. travel to the vertex, with a `BlockerEdge` where the path's shadow ray or auxiliary
+//!    ones to other points of the light are blocked (at the blocker's depth, the distance
+//!    from the path to the edge that the blocked and clear rays bound, docs/physics.md
+//!    section 3, "Where a shadow's edge is");
 //! 3. the reflection at the vertex (cov-brdf's `Reflect::with_turn`: the shape's curvature,
 //!    the material's lobe, and the turn from the plane of incidence to the plane of the
 //!    outgoing ray; then the change of handedness and the texture), inside `Moving` when
@@ -541,10 +542,23 @@ fn camera_side(
     Ok(chain)
 }
 
-/// The nearest blocker near the path from the light point `y` to the hit: auxiliary
-/// shadow rays to other points of the light; among the blocked ones, the blocker hit
-/// nearest to the path's segment. Returns (distance from the light along the path,
-/// distance from the path).
+/// The nearest blocker edge near the path from the light point `y` to the hit, found by
+/// the path's own shadow ray and auxiliary ones to other points of the light. Returns
+/// (distance from the light along the path, distance from the path to the edge at that
+/// depth), or `None` when no ray is blocked.
+///
+/// - The path's ray is clear: the edge lies between the path and the blocked rays'
+///   blockers; the nearest blocker hit's distance from the path's line bounds it.
+/// - The path's ray is blocked at depth `s`: the edge lies between the path and the clear
+///   rays; the nearest clear ray's distance from the path at that depth bounds it (the
+///   rays meet at the hit, so it is `(len − s) · |ω_k − ω_0|`). When every ray is blocked
+///   (an umbra), the widest of those distances: the sharpest edge the probes allow.
+///
+/// A point of the light below the surface's own horizon (on the other side of the
+/// geometric normal from the path's light) is skipped: the ray would meet the surface
+/// itself, which is the cosine's fall over the terminator (the lobe and the curvature),
+/// not a blocker's edge. Without this, convex shapes read a blocker at the hit near their
+/// terminator, and isolated pixels predicted hundreds of cycles per pixel.
 fn nearest_blocker<R: Rng>(
     world: &World,
     hit: &Hit,
@@ -559,9 +573,16 @@ fn nearest_blocker<R: Rng>(
         return None;
     }
     let dir = seg / len;
-    let mut best: Option<(f64, f64)> = None;
+    let w0 = -dir;
+    let lit_side = w0.dot(hit.ng);
+    // Nearest blocker hit off a clear path; the blocked path's depth; the clear probes'
+    // and the blocked probes' directions.
+    let mut off_path: Option<(f64, f64)> = None;
+    let mut own: Option<f64> = None;
+    let mut clear = [DVec3::ZERO; SHADOW_PROBES];
+    let mut blocked = [DVec3::ZERO; SHADOW_PROBES];
+    let (mut n_clear, mut n_blocked) = (0, 0);
     for k in 0..=SHADOW_PROBES {
-        // The path's own shadow ray first, then probes to other points of the light.
         let target = if k == 0 {
             y
         } else {
@@ -576,19 +597,42 @@ fn nearest_blocker<R: Rng>(
             continue;
         }
         let wi = d / dist;
+        if k > 0 && wi.dot(hit.ng) * lit_side <= 0.0 {
+            continue;
+        }
         let o = spawn(hit, wi);
-        if let Some(b) = world.geometry.intersect(o, wi, time, 0.0, dist * (1.0 - 1e-6)) {
-            // The blocker point relative to the path: its depth from the light, and its
-            // distance from the path's line.
-            let rel = b.p - y;
-            let along = rel.dot(dir).clamp(0.0, len);
-            let r = (rel - dir * rel.dot(dir)).length().max(1e-6 * len);
-            if best.is_none_or(|(_, br)| r < br) {
-                best = Some((along, r));
+        match world.geometry.intersect(o, wi, time, 0.0, dist * (1.0 - 1e-6)) {
+            Some(b) if k == 0 => own = Some((b.p - y).dot(dir).clamp(0.0, len)),
+            Some(b) => {
+                let rel = b.p - y;
+                let along = rel.dot(dir).clamp(0.0, len);
+                let r = (rel - dir * rel.dot(dir)).length();
+                if off_path.is_none_or(|(_, br)| r < br) {
+                    off_path = Some((along, r));
+                }
+                blocked[n_blocked] = wi;
+                n_blocked += 1;
             }
+            None if k > 0 => {
+                clear[n_clear] = wi;
+                n_clear += 1;
+            }
+            None => {}
         }
     }
-    best
+    let floor = 1e-6 * len;
+    match own {
+        None => off_path.map(|(s, r)| (s, r.max(floor))),
+        Some(s) => {
+            let apart = |w: &DVec3| (len - s) * (*w - w0).length();
+            let r = if n_clear > 0 {
+                clear[..n_clear].iter().map(apart).fold(f64::INFINITY, f64::min)
+            } else {
+                blocked[..n_blocked].iter().map(apart).fold(0.0, f64::max)
+            };
+            Some((s, r.max(floor)))
+        }
+    }
 }
 
 /// Depth difference that makes a silhouette, relative to the hit's depth: between what a
