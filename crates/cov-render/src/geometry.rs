@@ -61,7 +61,8 @@ pub struct Hit {
     pub ng: DVec3,
     /// Whether the ray hit the front (outward) side.
     pub front: bool,
-    /// Curvature seen from outside (1/m; a sphere of radius r: 1/r; flat: 0).
+    /// Curvature seen from outside (1/m; a sphere of radius r: 1/r; flat: 0; a triangle
+    /// with vertex normals: that of its shading surface, `shading_curvature`).
     pub curvature: f64,
     /// The primitive's velocity.
     pub velocity: DVec3,
@@ -74,6 +75,55 @@ pub struct Hit {
     /// `∂p/∂u` and `∂p/∂v` at the hit (m per unit; 0 where the shape has no coordinates
     /// or they are degenerate).
     pub dpduv: [DVec3; 2],
+}
+
+/// The curvature that a triangle's vertex normals `n` give its shading surface (1/m,
+/// positive where the surface bends away from the side of the geometric normal `ng`, as a
+/// sphere's outside): the principal curvature of the larger magnitude, so that the
+/// covariance pass never sees a smooth-shaded mesh flatter than it is shaded (a torus's
+/// tube bends more than its ring; the isotropic operator then takes the tube's).
+///
+/// Along each edge `e` the normal turns by `Δn`, and `Δn·e = eᵀ S e` for the shape
+/// operator `S` (exact for a sphere's normals: `|e|²/r`); the three edges give the three
+/// entries of `S` in the triangle's plane. A triangle whose edges do not determine `S`
+/// (degenerate, or `S` not finite) reads flat.
+fn shading_curvature(v: [DVec3; 3], n: [DVec3; 3], ng: DVec3) -> f64 {
+    let side = if (n[0] + n[1] + n[2]).dot(ng) < 0.0 {
+        -1.0
+    } else {
+        1.0
+    };
+    let a = (v[1] - v[0]).normalize_or_zero();
+    let b = ng.cross(a);
+    let rows = [(0, 1), (0, 2), (1, 2)].map(|(i, j)| {
+        let e = v[j] - v[i];
+        let (x, y) = (e.dot(a), e.dot(b));
+        ([x * x, 2.0 * x * y, y * y], side * (n[j] - n[i]).dot(e))
+    });
+    // Cramer's rule on the 3×3 system for (Sxx, Sxy, Syy).
+    let det3 = |m: [[f64; 3]; 3]| {
+        m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1]) - m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0])
+            + m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0])
+    };
+    let m = rows.map(|r| r.0);
+    let d = det3(m);
+    // Relative to the edges' scale (|e|⁶): below it the edges are too close to parallel.
+    let scale = rows.iter().map(|r| r.0[0] + r.0[2]).fold(0.0, f64::max).powi(3);
+    // (A NaN determinant fails the test too.)
+    if d.abs().partial_cmp(&(1e-12 * scale)) != Some(std::cmp::Ordering::Greater) {
+        return 0.0;
+    }
+    let solve = |k: usize| {
+        let mut mk = m;
+        for (row, r) in mk.iter_mut().zip(&rows) {
+            row[k] = r.1;
+        }
+        det3(mk) / d
+    };
+    let (sxx, sxy, syy) = (solve(0), solve(1), solve(2));
+    let (mean, half) = (0.5 * (sxx + syy), (0.25 * (sxx - syy).powi(2) + sxy * sxy).sqrt());
+    let k = if mean >= 0.0 { mean + half } else { mean - half };
+    if k.is_finite() { k } else { 0.0 }
 }
 
 /// `(∂p/∂u, ∂p/∂v)` of a triangle with edges `e1, e2` and texture coordinates `uv`
@@ -228,6 +278,7 @@ impl Prim {
                 let b1 = (q - v[0]).cross(e2).dot(area) / a2;
                 let b2 = e1.cross(q - v[0]).dot(area) / a2;
                 let b0 = 1.0 - b1 - b2;
+                let curvature = n.map_or(0.0, |vn| shading_curvature(v, vn, ng));
                 let ns = match n {
                     Some(vn) => {
                         let s = (vn[0] * b0 + vn[1] * b1 + vn[2] * b2).normalize_or_zero();
@@ -239,7 +290,7 @@ impl Prim {
                     Some(c) => (c[0] * b0 + c[1] * b1 + c[2] * b2, triangle_dpduv(e1, e2, c)),
                     None => (DVec2::ZERO, [DVec3::ZERO; 2]),
                 };
-                (ng, ns, 0.0, uvh, dp)
+                (ng, ns, curvature, uvh, dp)
             }
         };
         let front = n_out.dot(d) < 0.0;
@@ -328,5 +379,80 @@ impl Geometry {
                 None => f32::INFINITY,
             }
         })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A triangle of three points on a surface, with the surface's normals there.
+    fn on(f: impl Fn(f64, f64) -> (DVec3, DVec3), pts: [(f64, f64); 3]) -> ([DVec3; 3], [DVec3; 3], DVec3) {
+        let v = pts.map(|(s, t)| f(s, t).0);
+        let n = pts.map(|(s, t)| f(s, t).1);
+        let ng = (v[1] - v[0]).cross(v[2] - v[0]).normalize();
+        let ng = if ng.dot(n[0] + n[1] + n[2]) < 0.0 { -ng } else { ng };
+        (v, n, ng)
+    }
+
+    #[test]
+    fn a_smooth_shaded_triangle_has_its_surface_curvature() {
+        // A sphere of radius 2: every edge gives 1/2 exactly, at any orientation.
+        let sphere = |s: f64, t: f64| {
+            let n = DVec3::new(s.cos() * t.sin(), t.cos(), s.sin() * t.sin());
+            (DVec3::new(1.0, -3.0, 0.5) + 2.0 * n, n)
+        };
+        for pts in [
+            [(0.1, 1.0), (0.15, 1.02), (0.12, 1.07)],
+            [(2.0, 0.6), (2.1, 0.5), (2.05, 0.7)],
+        ] {
+            let (v, n, ng) = on(sphere, pts);
+            let k = shading_curvature(v, n, ng);
+            assert!((k - 0.5).abs() < 1e-9, "{k}");
+            // Seen with the geometric normal the other way, concave; normals flipped, the same.
+            assert!((shading_curvature(v, n, -ng) + 0.5).abs() < 1e-9);
+            assert!((shading_curvature(v, n.map(|x| -x), ng) - 0.5).abs() < 1e-9);
+        }
+        // A cylinder of radius 0.25 along z: principal curvatures 4 and 0; the larger.
+        let cyl = |s: f64, z: f64| {
+            let n = DVec3::new(s.cos(), s.sin(), 0.0);
+            (0.25 * n + DVec3::Z * z, n)
+        };
+        let (v, n, ng) = on(cyl, [(0.3, 0.0), (0.35, 0.1), (0.31, 0.2)]);
+        let k = shading_curvature(v, n, ng);
+        assert!((k - 4.0).abs() < 1e-2, "{k}");
+        // A saddle z = (x² − 3y²)/2 at the origin, normal up: it bends towards the normal
+        // along x (−1) and away along y (3); the 3.
+        let saddle = |x: f64, y: f64| {
+            let n = DVec3::new(-x, 3.0 * y, 1.0).normalize();
+            (DVec3::new(x, y, 0.5 * (x * x - 3.0 * y * y)), n)
+        };
+        let (v, n, ng) = on(saddle, [(-0.01, -0.01), (0.012, -0.008), (0.0, 0.011)]);
+        let k = shading_curvature(v, n, ng);
+        assert!((k - 3.0).abs() < 0.05, "{k}");
+        let (v, n, ng) = on(
+            |x, y| saddle(y, x),
+            [(-0.01, -0.01), (0.012, -0.008), (0.0, 0.011)],
+        );
+        assert!((shading_curvature(v, n, ng) - 3.0).abs() < 0.05);
+        // Its mirror image, z = (3y² − x²)/2 with the normal up: −3.
+        let mirrored = |x: f64, y: f64| {
+            let (p, n) = saddle(x, y);
+            (DVec3::new(p.x, p.y, -p.z), DVec3::new(-n.x, -n.y, n.z))
+        };
+        let (v, n, ng) = on(mirrored, [(-0.01, -0.01), (0.012, -0.008), (0.0, 0.011)]);
+        let k = shading_curvature(v, n, ng);
+        assert!((k + 3.0).abs() < 0.05, "{k}");
+        // Flat shading, and a degenerate triangle: flat.
+        let z = [DVec3::Z; 3];
+        assert_eq!(
+            shading_curvature([DVec3::ZERO, DVec3::X, DVec3::Y], z, DVec3::Z),
+            0.0
+        );
+        let line = [DVec3::ZERO, DVec3::X, 2.0 * DVec3::X];
+        assert_eq!(
+            shading_curvature(line, [DVec3::Z, DVec3::Y, DVec3::X], DVec3::Z),
+            0.0
+        );
     }
 }
