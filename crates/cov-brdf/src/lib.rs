@@ -296,12 +296,15 @@ impl Operator for Brdf {
 
 /// Reflection at a curved surface: projection, curvature, mirror symmetry, lobe, a turn of
 /// the surface frame from the plane of incidence to the plane of the outgoing ray (0 when
-/// the outgoing ray lies in the plane of incidence), inverse curvature, inverse projection
-/// to the outgoing direction.
+/// the outgoing ray lies in the plane of incidence), inverse curvature (the same
+/// surface's, its principal directions read in the turned frame), inverse projection to
+/// the outgoing direction.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Reflect {
     project: Project,
     curvature: Curvature,
+    /// The same curvature in the outgoing plane's frame (after the turn).
+    curvature_out: Curvature,
     lobe: Lobe,
     turn: Turn,
     unproject: Unproject,
@@ -352,11 +355,13 @@ impl Reflect {
         lobe: Lobe,
         turn: f64,
     ) -> Result<Self, CovError> {
+        let turn = Turn::new(spec::ReflectSpec::TURN.of(turn))?;
         Ok(Reflect {
             project: Project::new(cos_in)?,
             curvature,
+            curvature_out: curvature.in_turned_frame(turn),
             lobe: lobe.validated()?,
-            turn: Turn::new(spec::ReflectSpec::TURN.of(turn))?,
+            turn,
             unproject: Unproject::new(cos_out)?,
         })
     }
@@ -373,7 +378,8 @@ impl Operator for Reflect {
         if !self.turn.is_zero() {
             cov.rotate_frame_by(self.turn)?;
         }
-        self.curvature.apply_oblique(cov, self.unproject.cos(), -1.0)?;
+        self.curvature_out
+            .apply_oblique(cov, self.unproject.cos(), -1.0)?;
         Operator::apply(&self.unproject, cov)
     }
     fn requires(&self) -> cov_core::AxisSet {

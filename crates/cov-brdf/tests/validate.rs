@@ -167,6 +167,15 @@ fn reflect_turn_between_planes_of_incidence() {
     let mut then_rotated = run(&Reflect::new(1.0, 1.0, k, lobe).unwrap());
     RotateFrame::new(0.4).unwrap().apply(&mut then_rotated).unwrap();
     assert!((turned.to_matrix() - then_rotated.to_matrix()).norm() <= 1e-12 * turned.norm());
+    // An anisotropic curvature too: the surface's principal directions are fixed, so on
+    // the outgoing side they are read in the turned frame (they were read in the incident
+    // plane's frame before, which fails this by 30% of Σ's norm).
+    let k2 = Curvature::anisotropic(3.0, -0.5, 0.3).unwrap();
+    let turned = run(&Reflect::with_turn(1.0, 1.0, k2, lobe, 0.4).unwrap());
+    let mut then_rotated = run(&Reflect::new(1.0, 1.0, k2, lobe).unwrap());
+    RotateFrame::new(0.4).unwrap().apply(&mut then_rotated).unwrap();
+    let gap = (turned.to_matrix() - then_rotated.to_matrix()).norm();
+    assert!(gap <= 1e-12 * turned.norm(), "{gap} of {}", turned.norm());
     assert!(Reflect::with_turn(0.7, 0.8, k, lobe, f64::NAN).is_err());
     // A turn needs the 3D frame.
     assert_eq!(

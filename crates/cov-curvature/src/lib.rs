@@ -119,6 +119,21 @@ impl Curvature {
         }
     }
 
+    /// The same surface's curvature in the frame turned by `turn` (as
+    /// `Spectrum::rotate_frame_by` turns it): the principal direction's angle less the
+    /// turn. An isotropic curvature is the same in every frame and is returned as it is.
+    pub fn in_turned_frame(&self, turn: Turn) -> Self {
+        if self.kx == self.ky {
+            return *self;
+        }
+        let (c, s) = (self.turn.cos(), self.turn.sin());
+        let (ct, st) = (turn.cos(), turn.sin());
+        Curvature {
+            turn: Turn::towards(c * ct + s * st, s * ct - c * st).unwrap_or(self.turn),
+            ..*self
+        }
+    }
+
     /// The tensor `K = R(α) diag(kx, ky) R(α)ᵀ` in the frame: `(kxx, kxy, kyy)`.
     pub fn tensor(&self) -> (f64, f64, f64) {
         let (s, c) = (self.turn.sin(), self.turn.cos());

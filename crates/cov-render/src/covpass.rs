@@ -97,7 +97,8 @@ fn in_frame(v: DVec3, d: DVec3, x: DVec3) -> [f64; 2] {
 /// The per-pixel prediction of the covariance pass.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct PixelCov {
-    /// Image-space Σ in (cycles/px)²: `xx, xy, yy` (weighted mean over the pixel's paths).
+    /// Image-space Σ in (cycles/px)²: `xx, xy, yy` with `x` along the image's columns and
+    /// `y` down its rows, as the film's pixels (weighted mean over the pixel's paths).
     pub sigma: [f64; 3],
     /// Samples per pixel over pixel × lens × time (weighted mean).
     pub spp: f64,
@@ -446,7 +447,7 @@ fn at_surface(
     let bounce = Reflect::with_turn(
         cos_i.clamp(1e-6, 1.0),
         v.n.dot(d_out).clamp(1e-6, 1.0),
-        Curvature::isotropic(v.curvature)?,
+        Curvature::anisotropic(v.curvature.k1, v.curvature.k2, v.curvature.angle(t_in, y_in))?,
         mat.lobe(),
         t_out.dot(y_in).atan2(t_out.dot(t_in)),
     )?;
@@ -976,7 +977,10 @@ fn block_cov<R: Rng>(
             }
         })?;
         for (d, wgt) in r {
-            let s = [d.image_cov_px[0][0], d.image_cov_px[0][1], d.image_cov_px[1][1]];
+            // The chain ends in the camera's frame, `y` up (the ray frame's `d × x` with `x`
+            // the camera's right); the image's rows, the film's splats and the maps run
+            // down, so `xy` changes sign.
+            let s = [d.image_cov_px[0][0], -d.image_cov_px[0][1], d.image_cov_px[1][1]];
             if !(s.iter().all(|v| v.is_finite()) && d.samples_per_pixel.is_finite()) {
                 continue;
             }

@@ -61,9 +61,10 @@ pub struct Hit {
     pub ng: DVec3,
     /// Whether the ray hit the front (outward) side.
     pub front: bool,
-    /// Curvature seen from outside (1/m; a sphere of radius r: 1/r; flat: 0; a triangle
-    /// with vertex normals: that of its shading surface, `shading_curvature`).
-    pub curvature: f64,
+    /// Curvature seen from the side the ray came from (a sphere of radius r from outside:
+    /// 1/r both ways; flat: 0; a triangle with vertex normals: that of its shading surface,
+    /// `shading_curvature`).
+    pub curvature: Bend,
     /// The primitive's velocity.
     pub velocity: DVec3,
     /// Material index.
@@ -77,17 +78,53 @@ pub struct Hit {
     pub dpduv: [DVec3; 2],
 }
 
-/// The curvature that a triangle's vertex normals `n` give its shading surface (1/m,
-/// positive where the surface bends away from the side of the geometric normal `ng`, as a
-/// sphere's outside): the principal curvature of the larger magnitude, so that the
-/// covariance pass never sees a smooth-shaded mesh flatter than it is shaded (a torus's
-/// tube bends more than its ring; the isotropic operator then takes the tube's).
+/// A surface's principal curvatures at a point (1/m; positive where the surface bends
+/// away from the side its normal points to, as a sphere's outside): `k1` along the unit
+/// tangent `dir1`, `k2` across it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Bend {
+    /// Curvature along `dir1`.
+    pub k1: f64,
+    /// Curvature across `dir1`.
+    pub k2: f64,
+    /// Principal direction of `k1` (unit, tangent to the surface).
+    pub dir1: DVec3,
+}
+
+impl Bend {
+    /// The same curvature `k` in every direction of the plane normal to `n`.
+    pub fn isotropic(k: f64, n: DVec3) -> Bend {
+        Bend {
+            k1: k,
+            k2: k,
+            dir1: n.any_orthonormal_vector(),
+        }
+    }
+
+    /// The surface seen from its other side.
+    pub fn flipped(self) -> Bend {
+        Bend {
+            k1: -self.k1,
+            k2: -self.k2,
+            ..self
+        }
+    }
+
+    /// The angle (rad) of `dir1` from the tangent `x` towards the tangent `y`.
+    pub fn angle(&self, x: DVec3, y: DVec3) -> f64 {
+        self.dir1.dot(y).atan2(self.dir1.dot(x))
+    }
+}
+
+/// The curvature that a triangle's vertex normals `n` give its shading surface, seen from
+/// the side of the geometric normal `ng` (as a sphere's outside is positive).
 ///
 /// Along each edge `e` the normal turns by `Δn`, and `Δn·e = eᵀ S e` for the shape
 /// operator `S` (exact for a sphere's normals: `|e|²/r`); the three edges give the three
-/// entries of `S` in the triangle's plane. A triangle whose edges do not determine `S`
-/// (degenerate, or `S` not finite) reads flat.
-fn shading_curvature(v: [DVec3; 3], n: [DVec3; 3], ng: DVec3) -> f64 {
+/// entries of `S` in the triangle's plane, and its eigenvectors the principal directions.
+/// A triangle whose edges do not determine `S` (degenerate, or `S` not finite) reads
+/// flat.
+fn shading_curvature(v: [DVec3; 3], n: [DVec3; 3], ng: DVec3) -> Bend {
     let side = if (n[0] + n[1] + n[2]).dot(ng) < 0.0 {
         -1.0
     } else {
@@ -110,8 +147,13 @@ fn shading_curvature(v: [DVec3; 3], n: [DVec3; 3], ng: DVec3) -> f64 {
     // Relative to the edges' scale (|e|⁶): below it the edges are too close to parallel.
     let scale = rows.iter().map(|r| r.0[0] + r.0[2]).fold(0.0, f64::max).powi(3);
     // (A NaN determinant fails the test too.)
+    let flat = Bend {
+        k1: 0.0,
+        k2: 0.0,
+        dir1: a,
+    };
     if d.abs().partial_cmp(&(1e-12 * scale)) != Some(std::cmp::Ordering::Greater) {
-        return 0.0;
+        return flat;
     }
     let solve = |k: usize| {
         let mut mk = m;
@@ -122,8 +164,18 @@ fn shading_curvature(v: [DVec3; 3], n: [DVec3; 3], ng: DVec3) -> f64 {
     };
     let (sxx, sxy, syy) = (solve(0), solve(1), solve(2));
     let (mean, half) = (0.5 * (sxx + syy), (0.25 * (sxx - syy).powi(2) + sxy * sxy).sqrt());
-    let k = if mean >= 0.0 { mean + half } else { mean - half };
-    if k.is_finite() { k } else { 0.0 }
+    // The larger eigenvalue's eigenvector, at θ from `a` with tan 2θ = 2 Sxy / (Sxx − Syy).
+    let theta = 0.5 * (2.0 * sxy).atan2(sxx - syy);
+    let bend = Bend {
+        k1: mean + half,
+        k2: mean - half,
+        dir1: a * theta.cos() + b * theta.sin(),
+    };
+    if bend.k1.is_finite() && bend.k2.is_finite() && bend.dir1.is_finite() {
+        bend
+    } else {
+        flat
+    }
 }
 
 /// `(∂p/∂u, ∂p/∂v)` of a triangle with edges `e1, e2` and texture coordinates `uv`
@@ -267,7 +319,7 @@ impl Prim {
                 let uv = DVec2::new(0.5 + phi / (2.0 * PI), 1.0 - theta / PI);
                 let dpdu = DVec3::new(-st * sp, 0.0, st * cp) * (2.0 * PI * radius);
                 let dpdv = -DVec3::new(ct * cp, -st, ct * sp) * (PI * radius);
-                (n, n, 1.0 / radius, uv, [dpdu, dpdv])
+                (n, n, Bend::isotropic(1.0 / radius, n), uv, [dpdu, dpdv])
             }
             Shape::Triangle { v, n, uv } => {
                 let (e1, e2) = (v[1] - v[0], v[2] - v[0]);
@@ -278,7 +330,7 @@ impl Prim {
                 let b1 = (q - v[0]).cross(e2).dot(area) / a2;
                 let b2 = e1.cross(q - v[0]).dot(area) / a2;
                 let b0 = 1.0 - b1 - b2;
-                let curvature = n.map_or(0.0, |vn| shading_curvature(v, vn, ng));
+                let curvature = n.map_or(Bend::isotropic(0.0, ng), |vn| shading_curvature(v, vn, ng));
                 let ns = match n {
                     Some(vn) => {
                         let s = (vn[0] * b0 + vn[1] * b1 + vn[2] * b2).normalize_or_zero();
@@ -306,7 +358,7 @@ impl Prim {
             n,
             ng,
             front,
-            curvature: if front { curvature } else { -curvature },
+            curvature: if front { curvature } else { curvature.flipped() },
             velocity: self.velocity,
             material: self.material,
             light: self.light,
@@ -397,7 +449,7 @@ mod tests {
 
     #[test]
     fn a_smooth_shaded_triangle_has_its_surface_curvature() {
-        // A sphere of radius 2: every edge gives 1/2 exactly, at any orientation.
+        // A sphere of radius 2: 1/2 both ways, at any orientation.
         let sphere = |s: f64, t: f64| {
             let n = DVec3::new(s.cos() * t.sin(), t.cos(), s.sin() * t.sin());
             (DVec3::new(1.0, -3.0, 0.5) + 2.0 * n, n)
@@ -407,52 +459,53 @@ mod tests {
             [(2.0, 0.6), (2.1, 0.5), (2.05, 0.7)],
         ] {
             let (v, n, ng) = on(sphere, pts);
-            let k = shading_curvature(v, n, ng);
-            assert!((k - 0.5).abs() < 1e-9, "{k}");
+            let b = shading_curvature(v, n, ng);
+            assert!((b.k1 - 0.5).abs() < 1e-9 && (b.k2 - 0.5).abs() < 1e-9, "{b:?}");
             // Seen with the geometric normal the other way, concave; normals flipped, the same.
-            assert!((shading_curvature(v, n, -ng) + 0.5).abs() < 1e-9);
-            assert!((shading_curvature(v, n.map(|x| -x), ng) - 0.5).abs() < 1e-9);
+            let b = shading_curvature(v, n, -ng);
+            assert!((b.k1 + 0.5).abs() < 1e-9 && (b.k2 + 0.5).abs() < 1e-9, "{b:?}");
+            let b = shading_curvature(v, n.map(|x| -x), ng);
+            assert!((b.k1 - 0.5).abs() < 1e-9 && (b.k2 - 0.5).abs() < 1e-9, "{b:?}");
         }
-        // A cylinder of radius 0.25 along z: principal curvatures 4 and 0; the larger.
+        // A cylinder of radius 0.25 along z: 4 around it, 0 along its axis.
         let cyl = |s: f64, z: f64| {
             let n = DVec3::new(s.cos(), s.sin(), 0.0);
             (0.25 * n + DVec3::Z * z, n)
         };
         let (v, n, ng) = on(cyl, [(0.3, 0.0), (0.35, 0.1), (0.31, 0.2)]);
-        let k = shading_curvature(v, n, ng);
-        assert!((k - 4.0).abs() < 1e-2, "{k}");
+        let b = shading_curvature(v, n, ng);
+        assert!((b.k1 - 4.0).abs() < 1e-2 && b.k2.abs() < 1e-2, "{b:?}");
+        assert!(b.dir1.dot(DVec3::Z).abs() < 1e-3 && (b.dir1.length() - 1.0).abs() < 1e-12);
         // A saddle z = (x² − 3y²)/2 at the origin, normal up: it bends towards the normal
-        // along x (−1) and away along y (3); the 3.
+        // along x (−1) and away from it along y (3).
         let saddle = |x: f64, y: f64| {
             let n = DVec3::new(-x, 3.0 * y, 1.0).normalize();
             (DVec3::new(x, y, 0.5 * (x * x - 3.0 * y * y)), n)
         };
-        let (v, n, ng) = on(saddle, [(-0.01, -0.01), (0.012, -0.008), (0.0, 0.011)]);
-        let k = shading_curvature(v, n, ng);
-        assert!((k - 3.0).abs() < 0.05, "{k}");
-        let (v, n, ng) = on(
-            |x, y| saddle(y, x),
-            [(-0.01, -0.01), (0.012, -0.008), (0.0, 0.011)],
-        );
-        assert!((shading_curvature(v, n, ng) - 3.0).abs() < 0.05);
-        // Its mirror image, z = (3y² − x²)/2 with the normal up: −3.
-        let mirrored = |x: f64, y: f64| {
+        let pts = [(-0.01, -0.01), (0.012, -0.008), (0.0, 0.011)];
+        let (v, n, ng) = on(saddle, pts);
+        let b = shading_curvature(v, n, ng);
+        assert!((b.k1 - 3.0).abs() < 0.05 && (b.k2 + 1.0).abs() < 0.05, "{b:?}");
+        assert!(b.dir1.dot(DVec3::Y).abs() > 0.999, "{b:?}");
+        // Turned by 30° about z: the direction turns with it.
+        let turned = |x: f64, y: f64| {
+            let r = glam::DQuat::from_rotation_z(std::f64::consts::FRAC_PI_6);
             let (p, n) = saddle(x, y);
-            (DVec3::new(p.x, p.y, -p.z), DVec3::new(-n.x, -n.y, n.z))
+            (r * p, r * n)
         };
-        let (v, n, ng) = on(mirrored, [(-0.01, -0.01), (0.012, -0.008), (0.0, 0.011)]);
-        let k = shading_curvature(v, n, ng);
-        assert!((k + 3.0).abs() < 0.05, "{k}");
+        let (v, n, ng) = on(turned, pts);
+        let b = shading_curvature(v, n, ng);
+        let want = glam::DQuat::from_rotation_z(std::f64::consts::FRAC_PI_6) * DVec3::Y;
+        assert!(
+            (b.k1 - 3.0).abs() < 0.05 && b.dir1.dot(want).abs() > 0.999,
+            "{b:?}"
+        );
         // Flat shading, and a degenerate triangle: flat.
         let z = [DVec3::Z; 3];
-        assert_eq!(
-            shading_curvature([DVec3::ZERO, DVec3::X, DVec3::Y], z, DVec3::Z),
-            0.0
-        );
+        let b = shading_curvature([DVec3::ZERO, DVec3::X, DVec3::Y], z, DVec3::Z);
+        assert_eq!((b.k1, b.k2), (0.0, 0.0));
         let line = [DVec3::ZERO, DVec3::X, 2.0 * DVec3::X];
-        assert_eq!(
-            shading_curvature(line, [DVec3::Z, DVec3::Y, DVec3::X], DVec3::Z),
-            0.0
-        );
+        let b = shading_curvature(line, [DVec3::Z, DVec3::Y, DVec3::X], DVec3::Z);
+        assert_eq!((b.k1, b.k2), (0.0, 0.0));
     }
 }

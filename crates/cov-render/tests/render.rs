@@ -425,3 +425,131 @@ fn an_umbra_is_no_sharper_than_the_edge_around_it() {
         median(18)
     );
 }
+
+/// A smooth-shaded cylinder (an OBJ with radial vertex normals) filling the frame, its
+/// axis at 45° across the image, a Phong highlight along it: the covariance pass's Σ at
+/// the highlight is oriented as the rendered image is, its larger spectral spread across
+/// the streak (the mesh's principal curvatures and their direction, and the turn of the
+/// surface frame between the planes of incidence), in the image's rows. Turned the other
+/// way, both turn. With the maps' `y` running up (before 2026-11-27) the signs disagreed;
+/// with the mesh read flat or isotropic, `Σ_xy` is 0.3% of the content's trace or less,
+/// against 44% here.
+#[test]
+fn a_cylinder_highlight_is_oriented_as_the_image_is() {
+    let dir = std::env::temp_dir().join(format!("covtrace-cylinder-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    // A cylinder of radius 1.5 m and length 8 m along (cos tilt, sin tilt, 0), its front at
+    // z = 1.5 and its outlines out of the frame.
+    let cylinder = |tilt: f64| -> String {
+        let (seg, r, half) = (96, 1.5, 4.0);
+        let axis = glam::DVec3::new(tilt.cos(), tilt.sin(), 0.0);
+        let (u, w) = (glam::DVec3::new(-tilt.sin(), tilt.cos(), 0.0), glam::DVec3::Z);
+        let mut obj = String::new();
+        for end in [-half, half] {
+            for i in 0..seg {
+                let a = 2.0 * std::f64::consts::PI * i as f64 / seg as f64;
+                let n = u * a.cos() + w * a.sin();
+                let p = axis * end + n * r;
+                obj += &format!("v {} {} {}\nvn {} {} {}\n", p.x, p.y, p.z, n.x, n.y, n.z);
+            }
+        }
+        for i in 0..seg {
+            let (a, b) = (i + 1, (i + 1) % seg + 1);
+            let (c, d) = (a + seg, b + seg);
+            obj += &format!("f {a}//{a} {b}//{b} {d}//{d}\nf {a}//{a} {d}//{d} {c}//{c}\n");
+        }
+        obj
+    };
+    let xy_sign = |tilt: f64| -> (f64, f64) {
+        let (ax, ay) = (tilt.cos(), tilt.sin());
+        std::fs::write(dir.join("cyl.obj"), cylinder(tilt)).unwrap();
+        let text = format!(
+            r#"Scene(
+            camera: (position: (0.0, 0.0, 6.0), look_at: (0.0, 0.0, 0.0), up: (0.0, 1.0, 0.0), fov: 12.0, width: 32, height: 32),
+            materials: {{ "c": Phong(albedo: (0.8, 0.8, 0.8), exponent: 300.0) }},
+            lights: [Sphere(center: ({lx}, {ly}, 6.0), radius: 0.05, radiance: (400.0, 400.0, 400.0))],
+            shapes: [Mesh(obj: "cyl.obj", material: "c")],
+        )"#,
+            lx = 0.8 * ax,
+            ly = 0.8 * ay,
+        );
+        let world = World::from_text(&text, "<test>", &dir).unwrap_or_else(|e| panic!("{e}"));
+        let img = render(&world, 64, 1);
+        let maps = covariance_maps(&world, 16, 1, 1, None).unwrap();
+        let lum: Vec<f64> = img.pixels.iter().map(|p| p.y).collect();
+        let peak = lum.iter().copied().fold(0.0, f64::max);
+        // The image's structure tensor and the mean Σ_xy over the pixels of the highlight
+        // (above 30% of its peak), away from the frame's border.
+        let (mut j_xy, mut s_xy, mut s_tr, mut n) = (0.0, 0.0, 0.0, 0.0);
+        for y in 2..30 {
+            for x in 2..30 {
+                let k = y * 32 + x;
+                if lum[k] < 0.3 * peak {
+                    continue;
+                }
+                let gx = lum[k + 1] - lum[k - 1];
+                let gy = lum[k + 32] - lum[k - 32];
+                j_xy += gx * gy;
+                let s = maps.pixels[k].sigma;
+                s_xy += s[1];
+                s_tr += s[0] + s[2];
+                n += 1.0;
+            }
+        }
+        assert!(n >= 20.0, "{n} pixels in the highlight");
+        let f = cov_sensor::SensorParams::default().filter;
+        let own = 1.0 / (4.0 * std::f64::consts::PI.powi(2) * f * f);
+        (j_xy.signum(), s_xy / (s_tr - 2.0 * own * n))
+    };
+    for tilt in [0.25 * std::f64::consts::PI, -0.25 * std::f64::consts::PI] {
+        let (image, sigma) = xy_sign(tilt);
+        // The image's gradients run across the streak, and so does Σ's larger spread.
+        assert!(
+            image * sigma > 0.0 && sigma.abs() > 0.1,
+            "tilt {tilt}: image {image}, Σ_xy/tr {sigma}"
+        );
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// A small sphere moving diagonally across the frame during the shutter: the
+/// reconstruction filter at its streak is elongated along the streak, in the image's rows
+/// (its `xy` of the sign opposite to the image's gradients'). Before 2026-11-27 the maps
+/// kept the camera's `y` (up), and every filter was mirrored: across the streak.
+#[test]
+fn a_diagonal_streak_is_filtered_along_itself() {
+    for (vx, vy) in [(1.0, 1.0), (1.0, -1.0)] {
+        let text = format!(
+            r#"Scene(
+            camera: (position: (0.0, 0.0, 6.0), look_at: (0.0, 0.0, 0.0), up: (0.0, 1.0, 0.0), fov: 12.0, width: 32, height: 32, shutter: (open: 0.0, close: 0.2)),
+            materials: {{ "c": Diffuse(albedo: (0.8, 0.8, 0.8)), "bg": Diffuse(albedo: (0.1, 0.1, 0.1)) }},
+            lights: [Sphere(center: (0.0, 0.0, 8.0), radius: 0.5, radiance: (40.0, 40.0, 40.0))],
+            shapes: [Sphere(center: (0.0, 0.0, 0.0), radius: 0.12, material: "c", velocity: ({vx}, {vy}, 0.0)),
+                     Quad(corner: (-5.0, -5.0, -1.0), edge_u: (10.0, 0.0, 0.0), edge_v: (0.0, 10.0, 0.0), material: "bg")],
+        )"#
+        );
+        let world = World::from_text(&text, "<test>", std::path::Path::new(".")).unwrap();
+        let img = render(&world, 64, 1);
+        let maps = covariance_maps(&world, 16, 1, 1, None).unwrap();
+        let lum: Vec<f64> = img.pixels.iter().map(|p| p.y).collect();
+        let peak = lum.iter().copied().fold(0.0, f64::max);
+        let (mut j, mut f, mut n) = (0.0, [0.0; 3], 0.0);
+        for y in 2..30 {
+            for x in 2..30 {
+                let k = y * 32 + x;
+                j += (lum[k + 1] - lum[k - 1]) * (lum[k + 32] - lum[k - 32]);
+                if lum[k] > 0.2 * peak {
+                    let c = cov_render::adaptive::filter_cov(&maps.pixels[k]);
+                    (0..3).for_each(|i| f[i] += c[i]);
+                    n += 1.0;
+                }
+            }
+        }
+        assert!(n >= 20.0, "{n} pixels in the streak");
+        let corr = f[1] / (f[0] * f[2]).sqrt();
+        assert!(
+            j * corr < 0.0 && corr.abs() > 0.2,
+            "velocity ({vx}, {vy}): image {j}, filter's correlation {corr}"
+        );
+    }
+}
