@@ -553,3 +553,49 @@ fn a_diagonal_streak_is_filtered_along_itself() {
         );
     }
 }
+
+/// Diagonal stripes (a texture) on a plane facing the camera: Σ's spread runs across the
+/// stripes as the image's gradients do, in the image's rows. Before 2026-11-27 the maps'
+/// `y` ran up and `Σ_xy` came out with the sign opposite to the image's.
+#[test]
+fn diagonal_stripes_are_oriented_as_the_image_is() {
+    let f = cov_sensor::SensorParams::default().filter;
+    let own = 1.0 / (4.0 * std::f64::consts::PI.powi(2) * f * f);
+    for (ux, uy) in [(1.0, 1.0), (1.0, -1.0)] {
+        let (vx, vy) = (-uy, ux);
+        let text = format!(
+            r#"Scene(
+            camera: (position: (0.0, 0.0, 6.0), look_at: (0.0, 0.0, 0.0), up: (0.0, 1.0, 0.0), fov: 12.0, width: 32, height: 32),
+            textures: {{ "stripes": Stripes(count: 12, duty: 0.5, a: (0.3, 0.3, 0.3), b: (0.9, 0.9, 0.9)) }},
+            materials: {{ "wall": Diffuse(albedo: (1.0, 1.0, 1.0), texture: "stripes") }},
+            lights: [Sphere(center: (0.0, 0.0, 8.0), radius: 1.0, radiance: (10.0, 10.0, 10.0))],
+            shapes: [Quad(corner: ({cx}, {cy}, 0.0), edge_u: ({ex}, {ey}, 0.0), edge_v: ({fx}, {fy}, 0.0), material: "wall")],
+        )"#,
+            cx = -1.5 * (ux + vx),
+            cy = -1.5 * (uy + vy),
+            ex = 3.0 * ux,
+            ey = 3.0 * uy,
+            fx = 3.0 * vx,
+            fy = 3.0 * vy
+        );
+        let world = World::from_text(&text, "<test>", std::path::Path::new(".")).unwrap();
+        let img = render(&world, 16, 1);
+        let maps = covariance_maps(&world, 8, 1, 1, None).unwrap();
+        let lum: Vec<f64> = img.pixels.iter().map(|p| p.y).collect();
+        let (mut j, mut xx, mut xy) = (0.0, 0.0, 0.0);
+        for y in 4..28 {
+            for x in 4..28 {
+                let k = y * 32 + x;
+                j += (lum[k + 1] - lum[k - 1]) * (lum[k + 32] - lum[k - 32]);
+                xx += maps.pixels[k].sigma[0] - own;
+                xy += maps.pixels[k].sigma[1];
+            }
+        }
+        // Stripes at 45°: the content's spread is along one diagonal, `xy ≈ ±xx`.
+        assert!(
+            j * xy > 0.0 && (xy / xx).abs() > 0.5,
+            "stripes along ({ux}, {uy}): image {j}, Σ_xy/Σ_xx {}",
+            xy / xx
+        );
+    }
+}
