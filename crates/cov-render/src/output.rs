@@ -167,7 +167,7 @@ pub fn write_maps(
         "layout": maps.layout,
         "paths_per_block": maps.paths_per_block,
         "block_px": maps.stride,
-        "units": { "sigma": "(cycles/px)^2, [xx, xy, yy] per pixel", "spp": "samples per pixel over pixel x lens x time" },
+        "units": { "sigma": "(cycles/px)^2, [xx, xy, yy] per pixel, x along the columns, y down the rows", "spp": "samples per pixel over pixel x lens x time" },
         "sigma": maps.pixels.iter().flat_map(|p| p.sigma).collect::<Vec<f64>>(),
         "spp": maps.pixels.iter().map(|p| p.spp).collect::<Vec<f64>>(),
     });
