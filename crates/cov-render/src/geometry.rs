@@ -101,6 +101,18 @@ impl Bend {
         }
     }
 
+    /// The curvatures clamped to `±k_max` (a NaN reads 0): a mesh whose normals turn
+    /// within a sliver of a triangle bends no tighter than the smallest sphere allowed
+    /// at the point ([`min_size`]).
+    pub fn bounded(self, k_max: f64) -> Bend {
+        let clamp = |k: f64| if k.is_nan() { 0.0 } else { k.clamp(-k_max, k_max) };
+        Bend {
+            k1: clamp(self.k1),
+            k2: clamp(self.k2),
+            ..self
+        }
+    }
+
     /// The surface seen from its other side.
     pub fn flipped(self) -> Bend {
         Bend {
@@ -330,7 +342,9 @@ impl Prim {
                 let b1 = (q - v[0]).cross(e2).dot(area) / a2;
                 let b2 = e1.cross(q - v[0]).dot(area) / a2;
                 let b0 = 1.0 - b1 - b2;
-                let curvature = n.map_or(Bend::isotropic(0.0, ng), |vn| shading_curvature(v, vn, ng));
+                let curvature = n.map_or(Bend::isotropic(0.0, ng), |vn| {
+                    shading_curvature(v, vn, ng).bounded(1.0 / min_size(q))
+                });
                 let ns = match n {
                     Some(vn) => {
                         let s = (vn[0] * b0 + vn[1] * b1 + vn[2] * b2).normalize_or_zero();
@@ -498,6 +512,15 @@ mod tests {
         let want = glam::DQuat::from_rotation_z(std::f64::consts::FRAC_PI_6) * DVec3::Y;
         assert!(
             (b.k1 - 3.0).abs() < 0.05 && b.dir1.dot(want).abs() > 0.999,
+            "{b:?}"
+        );
+        // Normals that turn by 90° over a micrometre: bounded as the smallest sphere there.
+        let tiny = [DVec3::ZERO, DVec3::X * 1e-6, DVec3::Y * 1e-6];
+        let b = shading_curvature(tiny, [DVec3::Z, DVec3::X, DVec3::Y], DVec3::Z);
+        assert!(b.k1.abs() > 1e5, "{b:?}");
+        let b = b.bounded(1.0 / min_size(DVec3::ZERO));
+        assert!(
+            b.k1.abs() <= 1e6 && b.k2.abs() <= 1e6 && b.k1.abs() == 1e6,
             "{b:?}"
         );
         // Flat shading, and a degenerate triangle: flat.
