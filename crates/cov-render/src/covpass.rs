@@ -576,13 +576,12 @@ fn nearest_blocker<R: Rng>(
     let dir = seg / len;
     let w0 = -dir;
     let lit_side = w0.dot(hit.ng);
-    // Nearest blocker hit off a clear path; the blocked path's depth; the clear probes'
-    // and the blocked probes' directions.
+    // Nearest blocker hit off a clear path; the blocked path's depth (the path's own ray
+    // is traced first, so it is known before any probe); for a blocked path, the nearest
+    // clear probe's distance from it at that depth and the widest blocked probe's.
     let mut off_path: Option<(f64, f64)> = None;
     let mut own: Option<f64> = None;
-    let mut clear = [DVec3::ZERO; SHADOW_PROBES];
-    let mut blocked = [DVec3::ZERO; SHADOW_PROBES];
-    let (mut n_clear, mut n_blocked) = (0, 0);
+    let (mut nearest_clear, mut widest_blocked) = (f64::INFINITY, 0.0f64);
     for k in 0..=SHADOW_PROBES {
         let target = if k == 0 {
             y
@@ -602,8 +601,15 @@ fn nearest_blocker<R: Rng>(
             continue;
         }
         let o = spawn(hit, wi);
-        match world.geometry.intersect(o, wi, time, 0.0, dist * (1.0 - 1e-6)) {
-            Some(b) if k == 0 => own = Some((b.p - y).dot(dir).clamp(0.0, len)),
+        let blocker = world.geometry.intersect(o, wi, time, 0.0, dist * (1.0 - 1e-6));
+        if k == 0 {
+            own = blocker.map(|b| (b.p - y).dot(dir).clamp(0.0, len));
+            continue;
+        }
+        // How far this probe passes from the path at the blocked path's depth (the rays
+        // meet at the hit).
+        let apart = own.map(|s| (len - s) * (wi - w0).length());
+        match blocker {
             Some(b) => {
                 let rel = b.p - y;
                 let along = rel.dot(dir).clamp(0.0, len);
@@ -611,25 +617,25 @@ fn nearest_blocker<R: Rng>(
                 if off_path.is_none_or(|(_, br)| r < br) {
                     off_path = Some((along, r));
                 }
-                blocked[n_blocked] = wi;
-                n_blocked += 1;
+                if let Some(a) = apart {
+                    widest_blocked = widest_blocked.max(a);
+                }
             }
-            None if k > 0 => {
-                clear[n_clear] = wi;
-                n_clear += 1;
+            None => {
+                if let Some(a) = apart {
+                    nearest_clear = nearest_clear.min(a);
+                }
             }
-            None => {}
         }
     }
     let floor = 1e-6 * len;
     match own {
         None => off_path.map(|(s, r)| (s, r.max(floor))),
         Some(s) => {
-            let apart = |w: &DVec3| (len - s) * (*w - w0).length();
-            let r = if n_clear > 0 {
-                clear[..n_clear].iter().map(apart).fold(f64::INFINITY, f64::min)
+            let r = if nearest_clear.is_finite() {
+                nearest_clear
             } else {
-                blocked[..n_blocked].iter().map(apart).fold(0.0, f64::max)
+                widest_blocked
             };
             Some((s, r.max(floor)))
         }

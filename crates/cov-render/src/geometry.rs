@@ -15,6 +15,9 @@ use obvhs::bvh2::builder::build_bvh2;
 use obvhs::ray::{Ray, RayHit};
 
 /// What a primitive is.
+// Nearly every primitive of a scene is a triangle, so a sphere's unused bytes cost
+// little, and boxing the triangle would add a pointer chase to every hit.
+#[allow(clippy::large_enum_variant)]
 #[derive(Clone, Copy, Debug)]
 pub enum Shape {
     /// A sphere.
@@ -32,7 +35,25 @@ pub enum Shape {
         n: Option<[DVec3; 3]>,
         /// Vertex texture coordinates `(u, v)`.
         uv: Option<[DVec2; 3]>,
+        /// The shading surface's curvature, seen from the geometric normal's side
+        /// ([`Shape::triangle`]): the same at every point of the triangle.
+        bend: Bend,
     },
+}
+
+impl Shape {
+    /// A triangle of vertices `v` (at time 0), with optional vertex normals `n` and
+    /// texture coordinates `uv`. The curvature its normals give ([`shading_curvature`],
+    /// bounded by the smallest sphere allowed at its farthest vertex, [`min_size`]) is
+    /// computed here once, not at every hit: the path tracer's hits do not read it.
+    pub fn triangle(v: [DVec3; 3], n: Option<[DVec3; 3]>, uv: Option<[DVec2; 3]>) -> Shape {
+        let ng = (v[1] - v[0]).cross(v[2] - v[0]).normalize_or_zero();
+        let far = v[0].abs().max(v[1].abs()).max(v[2].abs());
+        let bend = n.map_or(Bend::isotropic(0.0, ng), |vn| {
+            shading_curvature(v, vn, ng).bounded(1.0 / min_size(far))
+        });
+        Shape::Triangle { v, n, uv, bend }
+    }
 }
 
 /// One primitive: a shape, its velocity, and what it is made of.
@@ -333,7 +354,7 @@ impl Prim {
                 let dpdv = -DVec3::new(ct * cp, -st, ct * sp) * (PI * radius);
                 (n, n, Bend::isotropic(1.0 / radius, n), uv, [dpdu, dpdv])
             }
-            Shape::Triangle { v, n, uv } => {
+            Shape::Triangle { v, n, uv, bend } => {
                 let (e1, e2) = (v[1] - v[0], v[2] - v[0]);
                 let area = e1.cross(e2);
                 let ng = area.normalize();
@@ -342,9 +363,6 @@ impl Prim {
                 let b1 = (q - v[0]).cross(e2).dot(area) / a2;
                 let b2 = e1.cross(q - v[0]).dot(area) / a2;
                 let b0 = 1.0 - b1 - b2;
-                let curvature = n.map_or(Bend::isotropic(0.0, ng), |vn| {
-                    shading_curvature(v, vn, ng).bounded(1.0 / min_size(q))
-                });
                 let ns = match n {
                     Some(vn) => {
                         let s = (vn[0] * b0 + vn[1] * b1 + vn[2] * b2).normalize_or_zero();
@@ -356,7 +374,7 @@ impl Prim {
                     Some(c) => (c[0] * b0 + c[1] * b1 + c[2] * b2, triangle_dpduv(e1, e2, c)),
                     None => (DVec2::ZERO, [DVec3::ZERO; 2]),
                 };
-                (ng, ns, curvature, uvh, dp)
+                (ng, ns, bend, uvh, dp)
             }
         };
         let front = n_out.dot(d) < 0.0;

@@ -857,11 +857,7 @@ fn lights(desc: &SceneFile, prims: &mut Vec<Prim>) -> Result<Vec<Light>, Failure
                 });
                 for tri in quad_triangles(c0, eu, ev) {
                     prims.push(Prim {
-                        shape: Shape::Triangle {
-                            v: tri,
-                            n: None,
-                            uv: None,
-                        },
+                        shape: Shape::triangle(tri, None, None),
                         velocity: DVec3::ZERO,
                         material: u32::MAX,
                         light: Some(index),
@@ -1019,11 +1015,7 @@ fn shapes(
                     return Err((edge_u.ordinal, "a Quad's edges are parallel (zero area)".into()));
                 }
                 for (tri, uv) in quad_triangles(v(*corner), eu, ev).into_iter().zip(QUAD_UV) {
-                    push(Shape::Triangle {
-                        v: tri,
-                        n: None,
-                        uv: Some(uv),
-                    });
+                    push(Shape::triangle(tri, None, Some(uv)));
                 }
             }
             ShapeDesc::Mesh {
@@ -1037,11 +1029,7 @@ fn shapes(
                 triangles += tris.len();
                 let (t, sc) = (translate.map_or(DVec3::ZERO, v), scale.map_or(1.0, |s| s.0));
                 for (p, n, uv) in tris {
-                    push(Shape::Triangle {
-                        v: p.map(|q| q * sc + t),
-                        n,
-                        uv,
-                    });
+                    push(Shape::triangle(p.map(|q| q * sc + t), n, uv));
                 }
             }
         }

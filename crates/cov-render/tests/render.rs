@@ -17,6 +17,14 @@ fn load(name: &str, w: u32, h: u32) -> World {
         .with_resolution(w, h)
 }
 
+/// The spectrum variance (cycles/px)² that the sensor's pixel filter adds on each image
+/// axis, `1/(4π² f²)` for a filter of std `f` px: what every pixel's Σ has beside the
+/// image's content.
+fn own_window() -> f64 {
+    let f = cov_sensor::SensorParams::default().filter;
+    1.0 / (4.0 * std::f64::consts::PI.powi(2) * f * f)
+}
+
 fn pool(threads: usize) -> rayon::ThreadPool {
     rayon::ThreadPoolBuilder::new()
         .num_threads(threads)
@@ -190,8 +198,7 @@ fn a_material_edge_weighs_by_its_contrast() {
         let world = World::from_text(&text, "<test>", std::path::Path::new(".")).unwrap();
         let maps = covariance_maps(&world, 4, 1, 1, None).unwrap();
         // Less the pixel filter's own window, which every pixel has.
-        let f = cov_sensor::SensorParams::default().filter;
-        let own = 1.0 / (4.0 * std::f64::consts::PI.powi(2) * f * f);
+        let own = own_window();
         let at = |x: usize| maps.pixels[4 * 8 + x].sigma[0] - own;
         (at(3).max(at(4)), at(0))
     };
@@ -260,8 +267,7 @@ fn a_mirror_shows_what_it_reflects() {
         maps(&scene(false), 2),
     );
     // Less the pixel filter's own window, which every pixel has.
-    let f = cov_sensor::SensorParams::default().filter;
-    let own = 1.0 / (4.0 * std::f64::consts::PI.powi(2) * f * f);
+    let own = own_window();
     // Rows 5 to 9 see the floor, away from where it meets the wall (rows 3 and 4), and the
     // reflected rays reach the wall below its top.
     for y in 5..10 {
@@ -305,8 +311,7 @@ fn a_plane_at_a_grazing_angle_is_no_silhouette() {
     )"#;
     let world = World::from_text(text, "<test>", std::path::Path::new(".")).unwrap();
     let maps = cov_render::covpass::covariance_rows(&world, 4, 1, 1, 1, 0..16, None).unwrap();
-    let f = cov_sensor::SensorParams::default().filter;
-    let own = 1.0 / (4.0 * std::f64::consts::PI.powi(2) * f * f);
+    let own = own_window();
     // Rows 12 to 15 see the floor 3 to 6 m away, at 10° to 19° from grazing.
     for y in 12..16 {
         for x in 4..12 {
@@ -338,8 +343,7 @@ fn a_texture_does_not_turn_with_the_rays_frame() {
     )"#;
     let world = World::from_text(text, "<test>", std::path::Path::new(".")).unwrap();
     let maps = cov_render::covpass::covariance_rows(&world, 4, 1, 1, 1, 0..16, None).unwrap();
-    let f = cov_sensor::SensorParams::default().filter;
-    let own = 1.0 / (4.0 * std::f64::consts::PI.powi(2) * f * f);
+    let own = own_window();
     let xx: Vec<f64> = (0..32 * 16).map(|i| maps.pixels[i].sigma[0] - own).collect();
     let lo = xx.iter().fold(f64::INFINITY, |a, &v| a.min(v));
     assert!(
@@ -361,8 +365,7 @@ fn a_texture_does_not_turn_with_the_rays_frame() {
 fn bandwidths(text: &str, paths: u32) -> Vec<f64> {
     let world = World::from_text(text, "<test>", std::path::Path::new(".")).unwrap();
     let maps = covariance_maps(&world, paths, 1, 1, None).unwrap();
-    let f = cov_sensor::SensorParams::default().filter;
-    let own = 1.0 / (4.0 * std::f64::consts::PI.powi(2) * f * f);
+    let own = own_window();
     maps.pixels
         .iter()
         .map(|p| (p.sigma[0] + p.sigma[2] - 2.0 * own).max(0.0).sqrt())
@@ -497,8 +500,7 @@ fn a_cylinder_highlight_is_oriented_as_the_image_is() {
             }
         }
         assert!(n >= 20.0, "{n} pixels in the highlight");
-        let f = cov_sensor::SensorParams::default().filter;
-        let own = 1.0 / (4.0 * std::f64::consts::PI.powi(2) * f * f);
+        let own = own_window();
         (j_xy.signum(), s_xy / (s_tr - 2.0 * own * n))
     };
     for tilt in [0.25 * std::f64::consts::PI, -0.25 * std::f64::consts::PI] {
@@ -559,8 +561,7 @@ fn a_diagonal_streak_is_filtered_along_itself() {
 /// `y` ran up and `Σ_xy` came out with the sign opposite to the image's.
 #[test]
 fn diagonal_stripes_are_oriented_as_the_image_is() {
-    let f = cov_sensor::SensorParams::default().filter;
-    let own = 1.0 / (4.0 * std::f64::consts::PI.powi(2) * f * f);
+    let own = own_window();
     for (ux, uy) in [(1.0, 1.0), (1.0, -1.0)] {
         let (vx, vy) = (-uy, ux);
         let text = format!(
