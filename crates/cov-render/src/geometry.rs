@@ -43,7 +43,7 @@ pub enum Shape {
 
 impl Shape {
     /// A triangle of vertices `v` (at time 0), with optional vertex normals `n` and
-    /// texture coordinates `uv`. The curvature its normals give ([`shading_curvature`],
+    /// texture coordinates `uv`. The curvature its normals give (`shading_curvature`,
     /// bounded by the smallest sphere allowed at its farthest vertex, [`min_size`]) is
     /// computed here once, not at every hit: the path tracer's hits do not read it.
     pub fn triangle(v: [DVec3; 3], n: Option<[DVec3; 3]>, uv: Option<[DVec2; 3]>) -> Shape {
