@@ -22,19 +22,32 @@
 //! ```
 //!
 //! The first line is what makes the check work: a filter that blurs detail the pass did
-//! not see predicts `x_p` badly from the neighbours, whatever Σ said. In the box's error
-//! and the noise term, `σ²` is the sample variance of the pixel's luminance over its
-//! count; it overstates the variance of a quasi-Monte Carlo mean, which makes the box
-//! look worse than it is, so the guard leans towards filtering where it cannot tell. The
-//! `σ²` taken off the residual is the estimate that sees the net's convergence
-//! ([`Film::variance_of_mean`]): there an overstated noise would hide the bias of a
-//! filter that blurs a faint texture (a felt directly lit, whose pixel means err 20 times
-//! less at 16 samples than at 4). A pixel with a single sample has no sample
-//! variance; it takes its neighbourhood's noise (the least, over four directions, of the
-//! neighbouring pixels' squared differences; see `one_sample_variance`). The estimates
-//! are relative (divided by the squared 3×3 mean luminance plus
-//! [`crate::metrics::REL_EPS`], the error the benchmarks report) and averaged over 3×3
-//! pixels before each pixel picks the smallest: one pixel's
+//! not see predicts `x_p` badly from the neighbours, whatever Σ said.
+//!
+//! **Which `σ²`.** In the box's error, `σ²` is the sample variance of the pixel's
+//! luminance over its count, Monte Carlo's `s²/n`. It overstates the variance of a
+//! quasi-Monte Carlo mean, which makes the box look worse than it is, so the guard leans
+//! towards filtering where it cannot tell. The box is the fall-back whose error rests on
+//! that one pixel's samples; where they missed a rare bright path (a caustic's
+//! fireflies), a smaller reading would keep the box exactly where it errs most (measured:
+//! reading the box's error as below raised `cov`'s error by up to 26%). Inside a filter's
+//! estimate, both `σ²` (its own share, `α² σ²`, and the noise taken off the residual)
+//! are the estimate that sees the net's convergence ([`Film::variance_of_mean`]). They
+//! are the variance of the same mean: an overstated noise taken off the residual would
+//! hide the bias of a filter that blurs a faint texture (a felt directly lit, whose pixel
+//! means err 20 times less at 16 samples than at 4), and an overstated own share makes a
+//! narrow filter, which keeps the texture, look worse than a wide one that blurs it (the
+//! unit test `a_converged_texture_is_not_blurred`). The narrowest candidate, which only
+//! stands in for the box ([`PILOT_SCALES`]), is judged on the box's terms, `s²/n`:
+//! judged as the others are, it took the box's place on the edges of a checker the pass
+//! was blind to, at 1.12× uniform sampling's error (`the_guard_protects_a_blind_pass`;
+//! 1.03× as it is, 0.99× before the own share was read as the net's convergence).
+//!
+//! A pixel with a single sample has no sample variance; it takes its neighbourhood's
+//! noise (the least, over four directions, of the neighbouring pixels' squared
+//! differences; see `one_sample_variance`). The estimates are relative (divided by the
+//! squared 3×3 mean luminance plus [`crate::metrics::REL_EPS`], the error the benchmarks
+//! report) and averaged over 3×3 pixels before each pixel picks the smallest: one pixel's
 //! squared residual is too noisy to decide alone (Stein's unbiased risk estimate, tried
 //! for the same choice, needs the variance of the estimate itself, which is as noisy).
 //!
@@ -196,8 +209,8 @@ fn choose(
         })
         .collect();
     let var = one_sample_variance(film);
-    // The variance of the pixel's mean in the box's error and the noise terms: Monte
-    // Carlo's, `s²/n` (an upper bound for a scrambled net's mean).
+    // The variance of the pixel's mean in the box's error: Monte Carlo's, `s²/n` (an
+    // upper bound for a scrambled net's mean).
     let s2: Vec<f64> = (0..n)
         .into_par_iter()
         .map(|i| var[i] / f64::from(film.count[i].max(1)))
@@ -218,13 +231,28 @@ fn choose(
         .into_par_iter()
         .map(|i| if film.count[i] >= 2 { of_mean[i] } else { s2[i] })
         .collect();
+    // The same variance at the target count, in a filter's own share of its estimate
+    // (`α² σ²`): the noise taken off its residual, read the same way (module docs).
+    let own_target: Vec<f64> = (0..n)
+        .into_par_iter()
+        .map(|i| {
+            let c = f64::from(film.count[i].max(1));
+            noise[i] * (c / target.max(c))
+        })
+        .collect();
     // The normaliser of the relative error: the squared 3×3 mean luminance.
     let norm: Vec<f64> = box3(w, h, &lx, rows)
         .par_iter()
         .map(|m| m * m + REL_EPS)
         .collect();
     let mut risks: Vec<Vec<f64>> = Vec::with_capacity(candidates.len() + 1);
-    for (filters, acc) in candidates.iter().zip(lum) {
+    for (k, (filters, acc)) in candidates.iter().zip(lum).enumerate() {
+        // The stand-in for the box is judged on the box's terms.
+        let own_target = if stand_in && k + 1 == candidates.len() {
+            &s2_target
+        } else {
+            &own_target
+        };
         let risk: Vec<f64> = (0..n)
             .into_par_iter()
             .map(|p| {
@@ -237,11 +265,11 @@ fn choose(
                 let (loo_w, alpha) = (wsum - own * c, (own * c / wsum).clamp(0.0, 1.0));
                 // Below this share the others carry no weight: nothing to cross-validate.
                 if loo_w <= 1e-9 * wsum {
-                    return s2_target[p] / norm[p];
+                    return own_target[p] / norm[p];
                 }
                 let loo = (sum - luminance(film.reflected[p]) * own) / loo_w;
                 let cv = (loo - lx[p]).powi(2);
-                (alpha * alpha * s2_target[p] + (1.0 - alpha).powi(2) * (cv - noise[p]).max(0.0)) / norm[p]
+                (alpha * alpha * own_target[p] + (1.0 - alpha).powi(2) * (cv - noise[p]).max(0.0)) / norm[p]
             })
             .collect();
         risks.push(box3(w, h, &risk, rows));
@@ -479,6 +507,62 @@ mod tests {
                     .all(|(f, c)| f.as_ref() != Some(c))
             );
         }
+    }
+
+    /// A fine texture (period 4 px) under a scrambled net's samples: each pixel's 16
+    /// samples spread widely (a sample variance of 0.32) but every half of them is
+    /// stratified, so a pixel's mean errs by a std of 0.0025 where Monte Carlo's `s²/n`
+    /// reads 0.14. Read that way, a narrow filter's own share of the noise looks thousands
+    /// of times larger than it is, and `F₀/4` (1 px), which keeps 29% of the texture,
+    /// wins everywhere; read as the net's convergence, the narrower `F₀/16` keeps 73%
+    /// and the error halves at least.
+    #[test]
+    fn a_converged_texture_is_not_blurred() {
+        use rand::{Rng, SeedableRng};
+        let (w, h, n) = (64u32, 48u32, 16u32);
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(17);
+        let truth = |x: u32| 2.0 + 0.1 * (std::f64::consts::TAU * (f64::from(x) + 0.5) / 4.0).sin();
+        let mut film = Film::new(w, h);
+        for y in 0..h {
+            for x in 0..w {
+                let i = (y * w + x) as usize;
+                let phase: f64 = rng.random();
+                let (mut s, mut s2, mut top) = (0.0, 0.0, 0.0);
+                for k in 0..n {
+                    let spread = 0.8 * (std::f64::consts::TAU * (f64::from(k) + phase) / 8.0).sin();
+                    let v = truth(x) + spread + 0.01 * normal(&mut rng);
+                    s += v;
+                    s2 += v * v;
+                    if k >= n / 2 {
+                        top += v;
+                    }
+                }
+                film.count[i] = n;
+                film.reflected[i] = DVec3::splat(s);
+                film.lum[i] = [s, s2];
+                film.lum_top[i] = top;
+            }
+        }
+        let cands: Vec<Vec<Gaussian>> = SCALES
+            .iter()
+            .map(|&k| vec![Gaussian::from_cov([4.0 * k, 0.0, 4.0 * k]); (w * h) as usize])
+            .collect();
+        let err = |img: &[DVec3]| {
+            let (mut e, mut k) = (0.0, 0.0);
+            for y in 4..h - 4 {
+                for x in 4..w - 4 {
+                    e += (img[(y * w + x) as usize].x - truth(x)).powi(2);
+                    k += 1.0;
+                }
+            }
+            e / k
+        };
+        let got = err(&guarded(&cands, &film, 0..h).reflected);
+        let alone: Vec<f64> = cands
+            .iter()
+            .map(|c| err(&film.image(&crate::film::Filter::PerPixel(c.clone())).pixels))
+            .collect();
+        assert!(got < 0.5 * alone[1], "{got} against {alone:?}");
     }
 
     /// One sample per pixel: a clean step reads as no noise beside it (the direction
