@@ -430,6 +430,46 @@ mod tests {
         film
     }
 
+    /// A film of `n` samples per pixel whose luminances are `samples(x, y)` (grey
+    /// radiance), with the second half's sum for the split estimate.
+    fn film_of(w: u32, h: u32, n: u32, mut samples: impl FnMut(u32, u32) -> Vec<f64>) -> Film {
+        let mut film = Film::new(w, h);
+        for y in 0..h {
+            for x in 0..w {
+                let i = (y * w + x) as usize;
+                let v = samples(x, y);
+                assert_eq!(v.len(), n as usize);
+                let s: f64 = v.iter().sum();
+                film.count[i] = n;
+                film.reflected[i] = DVec3::splat(s);
+                film.lum[i] = [s, v.iter().map(|a| a * a).sum()];
+                film.lum_top[i] = v[n as usize / 2..].iter().sum();
+            }
+        }
+        film
+    }
+
+    /// The guard's candidates for a matched filter `var · I` (px²) at every pixel.
+    fn isotropic_candidates(w: u32, h: u32, var: f64) -> Vec<Vec<Gaussian>> {
+        SCALES
+            .iter()
+            .map(|&k| vec![Gaussian::from_cov([var * k, 0.0, var * k]); (w * h) as usize])
+            .collect()
+    }
+
+    /// The mean squared error of an image's red channel against `truth(x)`, over the
+    /// pixels at least `margin` from the borders.
+    fn interior_mse(img: &[DVec3], w: u32, h: u32, margin: u32, truth: impl Fn(u32) -> f64) -> f64 {
+        let (mut e, mut k) = (0.0, 0.0);
+        for y in margin..h - margin {
+            for x in margin..w - margin {
+                e += (img[(y * w + x) as usize].x - truth(x)).powi(2);
+                k += 1.0;
+            }
+        }
+        e / k
+    }
+
     /// A noisy film of 16 samples per pixel over stripes of period 8 px, with every
     /// pixel's matched filter 8 px wide: the stripes keep 73% of their amplitude through
     /// a 1-px filter (`F₀/64`) and 29% through a 2-px one, and a pixel's mean has a noise
@@ -442,40 +482,12 @@ mod tests {
         let (w, h, n) = (64u32, 48u32, 16u32);
         let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(9);
         let truth = |x: u32| 2.0 + 0.3 * (std::f64::consts::TAU * (f64::from(x) + 0.5) / 8.0).sin();
-        let mut film = Film::new(w, h);
-        for y in 0..h {
-            for x in 0..w {
-                let i = (y * w + x) as usize;
-                let (mut s, mut s2, mut top) = (0.0, 0.0, 0.0);
-                for k in 0..n {
-                    let v = truth(x) + 0.4 * normal(&mut rng);
-                    s += v;
-                    s2 += v * v;
-                    if k >= n / 2 {
-                        top += v;
-                    }
-                }
-                film.count[i] = n;
-                film.reflected[i] = DVec3::splat(s);
-                film.lum[i] = [s, s2];
-                film.lum_top[i] = top;
-            }
-        }
-        let cands: Vec<Vec<Gaussian>> = SCALES
-            .iter()
-            .map(|&k| vec![Gaussian::from_cov([64.0 * k, 0.0, 64.0 * k]); (w * h) as usize])
-            .collect();
+        let film = film_of(w, h, n, |x, _| {
+            (0..n).map(|_| truth(x) + 0.4 * normal(&mut rng)).collect()
+        });
+        let cands = isotropic_candidates(w, h, 64.0);
         // The mean squared error over the pixels away from the borders.
-        let err = |img: &[DVec3]| {
-            let (mut e, mut k) = (0.0, 0.0);
-            for y in 8..h - 8 {
-                for x in 8..w - 8 {
-                    e += (img[(y * w + x) as usize].x - truth(x)).powi(2);
-                    k += 1.0;
-                }
-            }
-            e / k
-        };
+        let err = |img: &[DVec3]| interior_mse(img, w, h, 8, truth);
         let all = guarded(&cands, &film, 0..h);
         let wider = guarded(&cands[..PILOT_SCALES], &film, 0..h);
         let boxed: Vec<DVec3> = (0..(w * h) as usize)
@@ -522,41 +534,17 @@ mod tests {
         let (w, h, n) = (64u32, 48u32, 16u32);
         let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(17);
         let truth = |x: u32| 2.0 + 0.1 * (std::f64::consts::TAU * (f64::from(x) + 0.5) / 4.0).sin();
-        let mut film = Film::new(w, h);
-        for y in 0..h {
-            for x in 0..w {
-                let i = (y * w + x) as usize;
-                let phase: f64 = rng.random();
-                let (mut s, mut s2, mut top) = (0.0, 0.0, 0.0);
-                for k in 0..n {
+        let film = film_of(w, h, n, |x, _| {
+            let phase: f64 = rng.random();
+            (0..n)
+                .map(|k| {
                     let spread = 0.8 * (std::f64::consts::TAU * (f64::from(k) + phase) / 8.0).sin();
-                    let v = truth(x) + spread + 0.01 * normal(&mut rng);
-                    s += v;
-                    s2 += v * v;
-                    if k >= n / 2 {
-                        top += v;
-                    }
-                }
-                film.count[i] = n;
-                film.reflected[i] = DVec3::splat(s);
-                film.lum[i] = [s, s2];
-                film.lum_top[i] = top;
-            }
-        }
-        let cands: Vec<Vec<Gaussian>> = SCALES
-            .iter()
-            .map(|&k| vec![Gaussian::from_cov([4.0 * k, 0.0, 4.0 * k]); (w * h) as usize])
-            .collect();
-        let err = |img: &[DVec3]| {
-            let (mut e, mut k) = (0.0, 0.0);
-            for y in 4..h - 4 {
-                for x in 4..w - 4 {
-                    e += (img[(y * w + x) as usize].x - truth(x)).powi(2);
-                    k += 1.0;
-                }
-            }
-            e / k
-        };
+                    truth(x) + spread + 0.01 * normal(&mut rng)
+                })
+                .collect()
+        });
+        let cands = isotropic_candidates(w, h, 4.0);
+        let err = |img: &[DVec3]| interior_mse(img, w, h, 4, truth);
         let got = err(&guarded(&cands, &film, 0..h).reflected);
         let alone: Vec<f64> = cands
             .iter()
