@@ -246,7 +246,9 @@ fn bounce<S: Sampler + ?Sized>(
         return None;
     }
     let throughput = mat.eval(hit.n, wo, wi) * (cos / pdf);
-    let next = world.geometry.intersect(spawn(hit, wi), wi, time, 0.0, f64::INFINITY)?;
+    let next = world
+        .geometry
+        .intersect(spawn(hit, wi), wi, time, 0.0, f64::INFINITY)?;
     Some(Bounce {
         wi,
         pdf,
