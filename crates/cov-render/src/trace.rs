@@ -1,7 +1,7 @@
 //! The path tracer: direct lighting from area lights (light and BRDF sampling combined by
 //! multiple importance sampling) and one indirect bounce, over pixel × lens × time. At the
 //! second vertex, light sampling alone where the material is diffuse, and both
-//! strategies combined where it is glossy ([`second_vertex`]'s reason).
+//! strategies combined where it is glossy (the function `second_vertex` says why).
 //!
 //! The estimator is unbiased for the transport it includes: paths of one and two bounces
 //! (camera → x₁ → light, camera → x₁ → x₂ → light) and lights seen directly.
