@@ -215,14 +215,17 @@ fn choose(
         .into_par_iter()
         .map(|i| var[i] / f64::from(film.count[i].max(1)))
         .collect();
-    // The variance of the pixel's mean at the target count.
-    let s2_target: Vec<f64> = (0..n)
-        .into_par_iter()
-        .map(|i| {
-            let c = f64::from(film.count[i].max(1));
-            s2[i] * (c / target.max(c))
-        })
-        .collect();
+    // A variance of the pixel's mean at the target count: `n/target` of the film's.
+    let at_target = |v: &[f64]| -> Vec<f64> {
+        (0..n)
+            .into_par_iter()
+            .map(|i| {
+                let c = f64::from(film.count[i].max(1));
+                v[i] * (c / target.max(c))
+            })
+            .collect()
+    };
+    let s2_target = at_target(&s2);
     // The noise that the cross-validation residual carries, taken off it to leave the
     // filter's bias: the estimate that sees the net's convergence, so that Monte
     // Carlo's overstated noise does not hide a bias (module docs).
@@ -233,13 +236,7 @@ fn choose(
         .collect();
     // The same variance at the target count, in a filter's own share of its estimate
     // (`α² σ²`): the noise taken off its residual, read the same way (module docs).
-    let own_target: Vec<f64> = (0..n)
-        .into_par_iter()
-        .map(|i| {
-            let c = f64::from(film.count[i].max(1));
-            noise[i] * (c / target.max(c))
-        })
-        .collect();
+    let own_target = at_target(&noise);
     // The normaliser of the relative error: the squared 3×3 mean luminance.
     let norm: Vec<f64> = box3(w, h, &lx, rows)
         .par_iter()

@@ -45,8 +45,14 @@ fn footprint(world: &World, dist: f64) -> f64 {
     TEXTURE_FOOTPRINT * 2.0 * cam.tan_x * dist / cam.width as f64
 }
 
+/// The weight of a sample drawn with density `a` against the other strategy's density `b`
+/// for the same direction: the power heuristic with exponent 2, `a²/(a² + b²)`.
+fn power_heuristic(a: f64, b: f64) -> f64 {
+    a * a / (a * a + b * b)
+}
+
 /// Light sampling at a surface hit of material `mat`; with `mis`, weighted against BRDF
-/// sampling.
+/// sampling ([`power_heuristic`]).
 fn direct<S: Sampler + ?Sized>(
     world: &World,
     hit: &Hit,
@@ -76,8 +82,7 @@ fn direct<S: Sampler + ?Sized>(
     }
     let pl = ls.pdf / n_lights as f64;
     let w = if mis {
-        let pb = mat.pdf(hit.n, wo, ls.wi);
-        pl * pl / (pl * pl + pb * pb)
+        power_heuristic(pl, mat.pdf(hit.n, wo, ls.wi))
     } else {
         1.0
     };
@@ -213,8 +218,8 @@ struct Bounce {
 
 impl Bounce {
     /// The emission this bounce found, seen from `from`, weighted against light sampling
-    /// at `from` (the balance heuristic's square form, as in [`direct`]); 0 unless the
-    /// ray hit a light's front.
+    /// at `from` ([`power_heuristic`], as in [`direct`]); 0 unless the ray hit a light's
+    /// front.
     fn emission(&self, world: &World, from: &Hit) -> DVec3 {
         let (Some(li), le) = (self.hit.light, emitted(world, &self.hit)) else {
             return DVec3::ZERO;
@@ -224,8 +229,7 @@ impl Bounce {
         }
         let light = &world.lights[li as usize];
         let pl = light.pdf(from.p, self.wi, self.hit.t) / world.lights.len() as f64;
-        let pb = self.pdf;
-        self.throughput * le * (pb * pb / (pb * pb + pl * pl))
+        self.throughput * le * power_heuristic(self.pdf, pl)
     }
 }
 
@@ -272,6 +276,28 @@ mod tests {
         }
     }
 
+    /// A floor of `material` (RON) under a 1 m lamp, its point at the origin seen from
+    /// `(−1, 1, 0)` (45°, the lamp around the mirror direction): the world, the hit, its
+    /// material and the direction towards the viewer.
+    fn floor_under_lamp(material: &str) -> (World, Hit, Material, DVec3) {
+        let text = format!(
+            r#"Scene(
+            camera: (position: (0.0, 3.0, 3.0), look_at: (0.0, 0.0, 0.0), fov: 30.0, width: 4, height: 4),
+            materials: {{ "floor": {material} }},
+            lights: [Rect(corner: (0.5, 1.0, -0.5), edge_u: (1.0, 0.0, 0.0), edge_v: (0.0, 0.0, 1.0), radiance: (2.0, 2.0, 2.0))],
+            shapes: [Quad(corner: (-2.0, 0.0, -2.0), edge_u: (4.0, 0.0, 0.0), edge_v: (0.0, 0.0, 4.0), material: "floor")],
+        )"#
+        );
+        let world = World::from_text(&text, "<test>", Path::new(".")).unwrap();
+        let from = DVec3::new(-1.0, 1.0, 0.0);
+        let hit = world
+            .geometry
+            .intersect(from, -from.normalize(), 0.0, 0.0, f64::INFINITY)
+            .unwrap();
+        let mat = world.material_at(&hit, 0.0);
+        (world, hit, mat, from.normalize())
+    }
+
     /// Mean and variance of `n` draws of `f`.
     fn moments(n: u32, mut f: impl FnMut() -> f64) -> (f64, f64) {
         let (mut s, mut s2) = (0.0, 0.0);
@@ -291,19 +317,7 @@ mod tests {
     /// fraction of light sampling's.
     #[test]
     fn a_glossy_second_vertex_combines_light_and_brdf_sampling() {
-        let text = r#"Scene(
-            camera: (position: (0.0, 3.0, 3.0), look_at: (0.0, 0.0, 0.0), fov: 30.0, width: 4, height: 4),
-            materials: { "gloss": Phong(albedo: (0.8, 0.8, 0.8), exponent: 300.0) },
-            lights: [Rect(corner: (0.5, 1.0, -0.5), edge_u: (1.0, 0.0, 0.0), edge_v: (0.0, 0.0, 1.0), radiance: (2.0, 2.0, 2.0))],
-            shapes: [Quad(corner: (-2.0, 0.0, -2.0), edge_u: (4.0, 0.0, 0.0), edge_v: (0.0, 0.0, 4.0), material: "gloss")],
-        )"#;
-        let world = World::from_text(text, "<test>", Path::new(".")).unwrap();
-        let from = DVec3::new(-1.0, 1.0, 0.0);
-        let hit = world
-            .geometry
-            .intersect(from, -from.normalize(), 0.0, 0.0, f64::INFINITY)
-            .unwrap();
-        let (mat, wo) = (world.material_at(&hit, 0.0), from.normalize());
+        let (world, hit, mat, wo) = floor_under_lamp("Phong(albedo: (0.8, 0.8, 0.8), exponent: 300.0)");
         let mut rng = Uniform(rand_chacha::ChaCha8Rng::seed_from_u64(7));
         let n = 40_000;
         let combined = moments(n, || second_vertex(&world, &hit, &mat, wo, 0.0, &mut rng).y);
@@ -333,19 +347,7 @@ mod tests {
     /// without its MIS weight, drawn from the same generator.
     #[test]
     fn a_diffuse_second_vertex_samples_the_light_alone() {
-        let text = r#"Scene(
-            camera: (position: (0.0, 3.0, 3.0), look_at: (0.0, 0.0, 0.0), fov: 30.0, width: 4, height: 4),
-            materials: { "grey": Diffuse(albedo: (0.5, 0.5, 0.5)) },
-            lights: [Rect(corner: (0.5, 1.0, -0.5), edge_u: (1.0, 0.0, 0.0), edge_v: (0.0, 0.0, 1.0), radiance: (2.0, 2.0, 2.0))],
-            shapes: [Quad(corner: (-2.0, 0.0, -2.0), edge_u: (4.0, 0.0, 0.0), edge_v: (0.0, 0.0, 4.0), material: "grey")],
-        )"#;
-        let world = World::from_text(text, "<test>", Path::new(".")).unwrap();
-        let from = DVec3::new(-1.0, 1.0, 0.0);
-        let hit = world
-            .geometry
-            .intersect(from, -from.normalize(), 0.0, 0.0, f64::INFINITY)
-            .unwrap();
-        let (mat, wo) = (world.material_at(&hit, 0.0), from.normalize());
+        let (world, hit, mat, wo) = floor_under_lamp("Diffuse(albedo: (0.5, 0.5, 0.5))");
         let (mut a, mut b) = (
             Uniform(rand_chacha::ChaCha8Rng::seed_from_u64(3)),
             Uniform(rand_chacha::ChaCha8Rng::seed_from_u64(3)),
