@@ -424,11 +424,13 @@ fn render_one(
     }
     let (w, h) = (world.camera.width, world.camera.height);
     let [png, density, filter, json, aov] = outputs(output);
+    // "1 light", "2 lights".
+    let count = |n: usize, what: &str| format!("{n} {what}{}", if n == 1 { "" } else { "s" });
     let mut out = format!(
-        "scene: {} ({w}×{h} px, {} primitives, {} lights)\n",
+        "scene: {} ({w}×{h} px, {}, {})\n",
         cov_render::echo(&a.scene.display().to_string()),
-        world.geometry.len(),
-        world.lights.len(),
+        count(world.geometry.len(), "primitive"),
+        count(world.lights.len(), "light"),
     );
     let mut renderer = Renderer::new(world, settings.clone()).map_err(said)?;
     let (b, start) = match a.time {

@@ -520,6 +520,29 @@ fn line_start(text: &str, line: usize) -> Option<usize> {
     )
 }
 
+/// What the text holds at `line:col` (1-based, as the parser reports it), quoted: the word
+/// or number that starts there, or its one character (at most 24 characters, on one line),
+/// or "the end of the file".
+fn found_at(text: &str, line: usize, col: usize) -> String {
+    let rest = line_start(text, line).and_then(|s| text.get(s..)).map(|l| {
+        l.chars()
+            .skip(col.saturating_sub(1))
+            .skip_while(|c| *c == ' ' || *c == '\t')
+    });
+    let mut chars = match rest {
+        Some(c) => c.peekable(),
+        None => return "the end of the file".into(),
+    };
+    let word = |c: &char| c.is_alphanumeric() || matches!(*c, '_' | '.' | '-' | '+');
+    let token: String = match chars.peek() {
+        None => return "the end of the file".into(),
+        Some('\n' | '\r') => return "the end of the line".into(),
+        Some(c) if word(c) => chars.take_while(word).take(24).collect(),
+        Some(_) => chars.take(1).collect(),
+    };
+    format!("`{token}`")
+}
+
 /// The field whose value the parser refused at `line:col` (1-based, as it reports it) in
 /// `text`: the identifier before the `:` that precedes the value (a tuple is reported at
 /// its closing parenthesis, and its field precedes the opening one). `None` where the
@@ -576,6 +599,9 @@ impl SceneFile {
                 } else {
                     format!("`{name}`: {m}")
                 };
+            } else if message.starts_with("Expected") {
+                // A syntax error: say what stands where something else was expected.
+                message = format!("{message}, found {}", found_at(text, line, col));
             }
             SceneError {
                 file: file.to_string(),

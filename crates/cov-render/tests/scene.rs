@@ -448,3 +448,15 @@ fn small_inputs_cannot_ask_for_unbounded_work() {
         "{e}"
     );
 }
+
+/// A syntax error says what stands where something else was expected: the word or the
+/// character there, or the end of the line.
+#[test]
+fn a_syntax_error_says_what_it_found() {
+    let e = error(&scene(&[("FOV", "40.0,,")]));
+    assert!(e.ends_with("Expected identifier, found `,`"), "{e}");
+    let e = error(&scene(&[("FOV", "4o")]));
+    assert!(e.ends_with("Expected comma, found `o`"), "{e}");
+    let e = error(&scene(&[("FOV", "40.0 width")]));
+    assert!(e.ends_with("Expected comma, found `width`"), "{e}");
+}
