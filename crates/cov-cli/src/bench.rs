@@ -239,9 +239,10 @@ fn reference(
 ) -> Result<(cov_render::Image, String), String> {
     let (w, h) = (world.camera.width, world.camera.height);
     // The version names the path tracer's estimator: v2 combines light and BRDF sampling
-    // at a glossy second vertex, whose references lack v1's fireflies.
+    // at a glossy second vertex, whose references lack v1's fireflies; v3 maps textures on
+    // spheres unmirrored.
     let key = fnv(
-        format!("covtrace-reference-v2 {w}x{h} {} {}", a.ref_spp, a.seed).as_bytes(),
+        format!("covtrace-reference-v3 {w}x{h} {} {}", a.ref_spp, a.seed).as_bytes(),
         fnv(text, 0xcbf2_9ce4_8422_2325),
     );
     let exr = cache.join(format!("reference-{key:016x}.exr"));

@@ -345,13 +345,15 @@ impl Prim {
         let (n_out, ns_out, curvature, uv, dpduv) = match self.shape {
             Shape::Sphere { center, radius } => {
                 let n = (q - center) / radius;
-                // Longitude u from +x towards +z, latitude v from the south pole (−y).
-                let phi = n.z.atan2(n.x);
+                // Longitude u from +x towards −z, latitude v from the south pole (−y): seen
+                // from outside, u runs to the right and v up (∂p/∂u × ∂p/∂v points out of
+                // the sphere), so an image reads as it does on a quad, not mirrored.
+                let phi = (-n.z).atan2(n.x);
                 let theta = n.y.clamp(-1.0, 1.0).acos();
                 let (sp, cp, st, ct) = (phi.sin(), phi.cos(), theta.sin(), theta.cos());
                 let uv = DVec2::new(0.5 + phi / (2.0 * PI), 1.0 - theta / PI);
-                let dpdu = DVec3::new(-st * sp, 0.0, st * cp) * (2.0 * PI * radius);
-                let dpdv = -DVec3::new(ct * cp, -st, ct * sp) * (PI * radius);
+                let dpdu = DVec3::new(-st * sp, 0.0, -st * cp) * (2.0 * PI * radius);
+                let dpdv = -DVec3::new(ct * cp, -st, -ct * sp) * (PI * radius);
                 (n, n, Bend::isotropic(1.0 / radius, n), uv, [dpdu, dpdv])
             }
             Shape::Triangle { v, n, uv, bend } => {
@@ -477,6 +479,53 @@ mod tests {
         let ng = (v[1] - v[0]).cross(v[2] - v[0]).normalize();
         let ng = if ng.dot(n[0] + n[1] + n[2]) < 0.0 { -ng } else { ng };
         (v, n, ng)
+    }
+
+    /// A sphere's texture reads from outside as an image does on a quad: `u` grows to the
+    /// viewer's right and `v` up, wherever the viewer stands, so `∂p/∂u × ∂p/∂v` points out
+    /// of the sphere (the old longitude, from +x towards +z, mirrored every image), and the
+    /// derivatives are those of the coordinates (finite differences along the surface).
+    #[test]
+    fn a_sphere_texture_is_not_mirrored() {
+        let (c, r) = (DVec3::new(0.3, -0.2, 0.5), 0.7);
+        let prim = Prim {
+            shape: Shape::Sphere { center: c, radius: r },
+            velocity: DVec3::ZERO,
+            material: 0,
+            light: None,
+        };
+        // The hit of a ray from outside, towards the centre, from direction `dir`.
+        let at = |dir: DVec3| {
+            let o = c + 3.0 * dir.normalize();
+            prim.hit(o, -dir.normalize(), 3.0 - r, 0.0)
+        };
+        for dir in [
+            DVec3::Z,
+            DVec3::X,
+            -DVec3::Z,
+            DVec3::new(-1.0, 0.4, 0.3),
+            DVec3::new(0.2, -0.7, -0.5),
+        ] {
+            let h = at(dir);
+            let [du, dv] = h.dpduv;
+            assert!(du.cross(dv).dot(h.n) > 0.0, "{dir}: {:?}", h.dpduv);
+            // The viewer's right, for a view along −dir with +y up.
+            let right = (-dir).cross(DVec3::Y).normalize();
+            let step = 1e-4;
+            let beside = at(dir.normalize() + right * step);
+            let above = at(dir.normalize() + DVec3::Y * step);
+            assert!(
+                beside.uv.x > h.uv.x && above.uv.y > h.uv.y,
+                "{dir}: {:?} {:?} {:?}",
+                h.uv,
+                beside.uv,
+                above.uv
+            );
+            // ∂p/∂u predicts where a small step in u lands.
+            let d = beside.uv - h.uv;
+            let predicted = h.p + du * d.x + dv * d.y;
+            assert!((predicted - beside.p).length() < 1e-3 * step * r, "{dir}");
+        }
     }
 
     #[test]

@@ -313,7 +313,9 @@ pub enum MaterialDesc {
 }
 
 /// A texture: a reflectance map over a surface's `(u, v)` (quads: `u` along `edge_u`,
-/// `v` along `edge_v`; spheres: longitude and latitude; meshes: the OBJ's coordinates).
+/// `v` along `edge_v`; spheres: longitude from +x towards −z and latitude from the south
+/// pole, so that an equirectangular image reads from outside as on a quad, u = 0.5 facing
+/// +x; meshes: the OBJ's coordinates).
 #[derive(Clone, Debug, Deserialize)]
 #[serde(deny_unknown_fields, rename = "Texture")]
 pub enum TextureDesc {
