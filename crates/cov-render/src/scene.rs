@@ -30,13 +30,13 @@
 //! | `camera.shutter.open`, `close` | s | shutter interval, `close − open` in [`SHUTTER_RANGE`] (1e-15 to 1e6) |
 //! | `camera.velocity` | m/s | camera motion during the shutter; the camera stays within ±[`crate::geometry::MAX_COORD`] of the origin over it (and at every frame rendered) |
 //! | `camera.frame_rate` | 1/s | frames per second of an animation (`--frame K` moves the shutter and a still's instant by `K / frame_rate`), default 24 |
-//! | `textures` | | named `Checker(checks, a, b)`, `Stripes(count, duty, a, b)`, `Noise(cells, a, b, seed)` (generated; `size` texels per side, default 1024), `Image(file)` (PNG or EXR, relative to the scene file); all take `repeat: (u, v)` |
+//! | `textures` | | named `Checker(checks, a, b)`, `Stripes(count, duty, a, b)`, `Noise(cells, a, b, seed)` (generated; `size` texels per side, default 1024), `Image(file)` (PNG, sRGB, 8 or 16 bits, grey or colour, its alpha ignored; or EXR, linear, with R, G and B channels; relative to the scene file; texels clamped to 0 to 1, NaN to 0); all take `repeat: (u, v)` |
 //! | `materials` | | named `Diffuse(albedo)`, `Phong(albedo, exponent)`, `Ggx(albedo, alpha)`, each with an optional `texture` that multiplies the albedo |
 //! | `lights` | | `Rect(corner, edge_u, edge_v, radiance)`, `Sphere(center, radius, radiance)`; radiance in W/(m² sr) per channel |
-//! | `shapes` | | `Sphere(center, radius, material, velocity)`, `Quad(corner, edge_u, edge_v, material, velocity)`, `Mesh(obj, material, translate, scale, velocity)` |
+//! | `shapes` | | `Sphere(center, radius, material, velocity)`, `Quad(corner, edge_u, edge_v, material, velocity)`, `Mesh(obj, material, translate, scale, velocity)` (one material for the whole mesh: the OBJ's `mtllib` and `usemtl` lines are not read; a mesh without texture coordinates `vt` reads its material's texture at `(0, 0)`) |
 //! | colours (`albedo`, texture colours, `radiance`) | | each entry 0 to [`MAX_COLOUR`] (1e9) |
 //! | every shape and light | m | within ±[`crate::geometry::MAX_COORD`] (1e12) of the origin, with its motion over the shutter (and at every frame rendered) |
-//! | a sphere's radius, a quad's or rect light's edges | m | at least [`crate::geometry::MIN_SIZE`] × (1 m + the largest \|coordinate\| of its centre or corner) |
+//! | a sphere's radius, a quad's or rect light's edges, a mesh's extent | m | at least [`crate::geometry::MIN_SIZE`] × (1 m + the largest \|coordinate\| of its centre or corner) |
 
 use std::collections::BTreeMap;
 

@@ -210,7 +210,15 @@ impl TextureMap {
                 _ => Err("not a PNG or EXR image (the formats textures are read from)".to_string()),
             }
         };
-        let (w, h) = open()?.into_dimensions().map_err(|e| one(&e))?;
+        // A header whose size passes the decoder's own memory limit fails there already.
+        let (w, h) = open()?.into_dimensions().map_err(|e| match e {
+            image::ImageError::Limits(_) => {
+                format!(
+                    "the image is larger than textures are read, up to {MAX_TEXTURE_SIDE} texels per side"
+                )
+            }
+            e => one(&e),
+        })?;
         if w == 0 || h == 0 || w > MAX_TEXTURE_SIDE || h > MAX_TEXTURE_SIDE {
             return Err(format!(
                 "the image is {w}x{h}; texture images are read up to {MAX_TEXTURE_SIDE} texels per side"
@@ -659,6 +667,25 @@ mod tests {
         assert!(TextureMap::stripes(2, 1.0, DVec3::ZERO, DVec3::ONE, 8, DVec2::ONE).is_err());
         assert!(TextureMap::noise(2, 0, DVec3::ZERO, DVec3::ONE, MAX_TEXTURE_SIDE + 1, DVec2::ONE).is_err());
         assert!(TextureMap::load(Path::new("/nonexistent.png"), DVec2::ONE).is_err());
+        // A PNG whose header declares 2³¹ − 1 × 1 texels (68 bytes): the decoder's memory
+        // limit refuses it before our own size check can, and the message says why.
+        let dir = std::env::temp_dir().join(format!("covtrace-texture-test-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).expect("temp dir");
+        let wide = dir.join("wide.png");
+        std::fs::write(
+            &wide,
+            [
+                0x89, 0x50, 0x4e, 0x47, 0x0d, 0x0a, 0x1a, 0x0a, 0x00, 0x00, 0x00, 0x0d, 0x49, 0x48, 0x44,
+                0x52, 0x7f, 0xff, 0xff, 0xff, 0x00, 0x00, 0x00, 0x01, 0x08, 0x02, 0x00, 0x00, 0x00, 0x2f,
+                0x54, 0xa4, 0x8a, 0x00, 0x00, 0x00, 0x0b, 0x49, 0x44, 0x41, 0x54, 0x78, 0x9c, 0x63, 0x60,
+                0x80, 0x01, 0x00, 0x00, 0x0a, 0x00, 0x01, 0x7f, 0x80, 0x74, 0x5e, 0x00, 0x00, 0x00, 0x00,
+                0x49, 0x45, 0x4e, 0x44, 0xae, 0x42, 0x60, 0x82,
+            ],
+        )
+        .expect("write PNG");
+        let e = TextureMap::load(&wide, DVec2::ONE).unwrap_err();
+        assert!(e.starts_with("the image is larger than textures are read"), "{e}");
+        std::fs::remove_dir_all(&dir).expect("clean up");
         // A file that is no image says so, in its own words.
         let this = Path::new(env!("CARGO_MANIFEST_DIR")).join("Cargo.toml");
         let e = TextureMap::load(&this, DVec2::ONE).unwrap_err();

@@ -1028,6 +1028,29 @@ fn shapes(
                     .map_err(|e| (obj.ordinal, format!("OBJ `{}`: {e}", crate::echo(&obj.value))))?;
                 triangles += tris.len();
                 let (t, sc) = (translate.map_or(DVec3::ZERO, v), scale.map_or(1.0, |s| s.0));
+                // As a sphere's radius or a quad's edge: the mesh's extent, scaled, against
+                // the least size where it is placed.
+                let (lo, hi) = tris
+                    .iter()
+                    .flat_map(|(p, _, _)| p.iter())
+                    .fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(lo, hi), &q| {
+                        (lo.min(q * sc + t), hi.max(q * sc + t))
+                    });
+                let (size, least) = (
+                    (hi - lo).max_element(),
+                    crate::geometry::min_size(0.5 * (lo + hi)),
+                );
+                if !(size >= least) {
+                    return Err((
+                        obj.ordinal,
+                        format!(
+                            "this mesh is {} m across after its `scale`; at least {} m here ({:e} of 1 m + its distance along an axis from the origin)",
+                            cov_core::num(size),
+                            cov_core::num(least),
+                            crate::geometry::MIN_SIZE
+                        ),
+                    ));
+                }
                 for (p, n, uv) in tris {
                     push(Shape::triangle(p.map(|q| q * sc + t), n, uv));
                 }
@@ -1065,11 +1088,16 @@ fn load_obj(path: &Path, limit: usize) -> Result<Vec<ObjTriangle>, String> {
         ..Default::default()
     };
     let bytes = read_bounded(path, MAX_OBJ_BYTES, "OBJ").map_err(|e| cov_core::one_line(&e))?;
+    // A byte-order mark is not an OBJ statement, and a byte that is not UTF-8 (a Latin-1
+    // letter in a comment or a name) stops the reader: both are read past, the second as
+    // U+FFFD, which no number or index contains.
+    let bytes = bytes.strip_prefix(b"\xef\xbb\xbf").unwrap_or(&bytes);
+    let text = String::from_utf8_lossy(bytes);
     // Materials come from the scene: an `mtllib` line is not followed (it could name a
     // device or a pipe).
     let no_materials = |_: &Path| Ok((Vec::new(), Default::default()));
-    let (models, _materials) = tobj::load_obj_buf(&mut &bytes[..], &opts, no_materials)
-        .map_err(|e| cov_core::one_line(&e.to_string()))?;
+    let (models, _materials) =
+        tobj::load_obj_buf(&mut text.as_bytes(), &opts, no_materials).map_err(obj_error)?;
     let mut out = Vec::new();
     for m in &models {
         let mesh = &m.mesh;
@@ -1085,10 +1113,12 @@ fn load_obj(path: &Path, limit: usize) -> Result<Vec<ObjTriangle>, String> {
                     "more than {MAX_TRIANGLES} triangles in the scene; meshes are read up to that"
                 ));
             }
+            // The reader checked every index against the file's vertices.
+            let bad = "a vertex (`v`) has a coordinate that is not a finite number";
             let p = [
-                get(&mesh.positions, f[0]).ok_or("a vertex index is out of range or not finite")?,
-                get(&mesh.positions, f[1]).ok_or("a vertex index is out of range or not finite")?,
-                get(&mesh.positions, f[2]).ok_or("a vertex index is out of range or not finite")?,
+                get(&mesh.positions, f[0]).ok_or(bad)?,
+                get(&mesh.positions, f[1]).ok_or(bad)?,
+                get(&mesh.positions, f[2]).ok_or(bad)?,
             ];
             let n = if mesh.normals.is_empty() {
                 None
@@ -1126,7 +1156,32 @@ fn load_obj(path: &Path, limit: usize) -> Result<Vec<ObjTriangle>, String> {
     if out.is_empty() {
         return Err("the file has no triangles".into());
     }
+    if out
+        .iter()
+        .all(|(p, _, _)| (p[1] - p[0]).cross(p[2] - p[0]) == DVec3::ZERO)
+    {
+        return Err(
+            "every triangle of the file has zero area (a face of two points, or three in a line)".into(),
+        );
+    }
     Ok(out)
+}
+
+/// The reader's error in words that say which statement of the file is wrong (the reader
+/// does not give its line).
+fn obj_error(e: tobj::LoadError) -> String {
+    use tobj::LoadError as E;
+    match e {
+        E::PositionParseError => "a vertex (`v`) whose coordinates are not three or four numbers".into(),
+        E::NormalParseError => "a normal (`vn`) whose coordinates are not three numbers".into(),
+        E::TexcoordParseError => "a texture coordinate (`vt`) that is not one to three numbers".into(),
+        E::FaceParseError => "a face (`f`) whose entries are not `v`, `v/vt`, `v//vn` or `v/vt/vn` indices".into(),
+        E::FaceVertexOutOfBounds => "a face (`f`) refers to a vertex (`v`) the file does not have (indices count from 1, or from −1 backwards)".into(),
+        E::FaceTexCoordOutOfBounds => "a face (`f`) refers to a texture coordinate (`vt`) the file does not have".into(),
+        E::FaceNormalOutOfBounds => "a face (`f`) refers to a normal (`vn`) the file does not have".into(),
+        E::ScalingByZeroError => "a vertex (`v`) with a weight `w` of 0".into(),
+        e => cov_core::one_line(&e.to_string()),
+    }
 }
 
 /// Frames per second of an animation when the scene does not say.

@@ -460,3 +460,69 @@ fn a_syntax_error_says_what_it_found() {
     let e = error(&scene(&[("FOV", "40.0 width")]));
     assert!(e.ends_with("Expected comma, found `width`"), "{e}");
 }
+
+/// OBJ files a new user brought: a byte-order mark and a Latin-1 comment are read past;
+/// a bad vertex, a face beyond the vertices, a NaN coordinate, faces of no area and a mesh
+/// scaled below the least size each say what is wrong, in one positioned line.
+#[test]
+fn obj_files_say_what_is_wrong_with_them() {
+    let dir = std::env::temp_dir().join(format!("covtrace-obj-test-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).expect("temp dir");
+    let tri = "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n";
+    let cases: [(&str, Vec<u8>, &str, &str); 7] = [
+        ("bom.obj", [&b"\xef\xbb\xbf"[..], tri.as_bytes()].concat(), "", ""),
+        (
+            "latin1.obj",
+            [&b"# mod\xe9lis\xe9\n"[..], tri.as_bytes()].concat(),
+            "",
+            "",
+        ),
+        (
+            "badnum.obj",
+            b"v 1 abc 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n".to_vec(),
+            "",
+            "a vertex (`v`) whose coordinates are not",
+        ),
+        (
+            "oob.obj",
+            b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 7\n".to_vec(),
+            "",
+            "refers to a vertex (`v`) the file does not have",
+        ),
+        (
+            "nan.obj",
+            b"v nan 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n".to_vec(),
+            "",
+            "a coordinate that is not a finite number",
+        ),
+        (
+            "line.obj",
+            b"v 0 0 0\nv 1 0 0\nv 2 0 0\nf 1 2 3\n".to_vec(),
+            "",
+            "every triangle of the file has zero area",
+        ),
+        (
+            "tiny.obj",
+            tri.as_bytes().to_vec(),
+            ", scale: 1e-300",
+            "this mesh is 1e-300 m across",
+        ),
+    ];
+    for (name, bytes, extra, want) in cases {
+        let path = dir.join(name);
+        std::fs::write(&path, bytes).expect("write OBJ");
+        let text = scene(&[(
+            "SHAPE",
+            &format!(r#"Mesh(obj: "{}", material: "w"{extra})"#, path.display()),
+        )]);
+        if want.is_empty() {
+            let w =
+                World::from_text(&text, "s.ron", Path::new(".")).unwrap_or_else(|e| panic!("{name}: {e}"));
+            assert!(w.geometry.len() >= 2, "{name}");
+        } else {
+            let e = error(&text);
+            assert!(e.contains(want), "{name}: {e}");
+        }
+    }
+    std::fs::remove_dir_all(&dir).expect("clean up");
+}
