@@ -1040,7 +1040,7 @@ fn shapes(
                     (hi - lo).max_element(),
                     crate::geometry::min_size(0.5 * (lo + hi)),
                 );
-                if !(size >= least) {
+                if size.is_nan() || size < least {
                     return Err((
                         obj.ordinal,
                         format!(
