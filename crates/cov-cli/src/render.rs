@@ -500,10 +500,15 @@ fn render_one(
             .lights
             .iter()
             .any(|l| matches!(l, cov_render::world::Light::Rect { .. }));
-        out.push_str(&format!(
-            "warning: the image is black: no light reached the camera (is every light's radiance 0, or does the camera see only what no light reaches?{})\n",
-            if rect { " A Rect light emits on the side of edge_u × edge_v." } else { "" }
-        ));
+        // A warning, on the standard error beside the errors, not among the results.
+        eprintln!(
+            "warning: the image is black: no light reached the camera (is every light's radiance 0, or does the camera see only what no light reaches?{})",
+            if rect {
+                " A Rect light emits on the side of edge_u × edge_v."
+            } else {
+                ""
+            }
+        );
     }
     let mut written = vec![output.to_path_buf(), png, aov];
     if renderer.maps().is_some() {

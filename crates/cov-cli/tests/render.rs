@@ -337,8 +337,29 @@ fn a_black_image_says_so() {
 )"#;
     let file = tmp("upward_light.ron");
     std::fs::write(&file, text).expect("write scene");
-    let (_, stdout) = render(file.to_str().expect("utf-8"), "upward_light", &["--spp", "2"]);
-    assert!(stdout.contains("warning: the image is black"), "{stdout}");
-    let (_, stdout) = render("examples/scenes/cornell.ron", "not_black", &["--spp", "2"]);
-    assert!(!stdout.contains("warning"), "{stdout}");
+    // On the standard error, where warnings and errors go, not among the results.
+    let stderr = |scene: &str, name: &str| {
+        let exr = tmp(&format!("{name}.exr"));
+        let args = [
+            "render",
+            scene,
+            "--size",
+            "32x24",
+            "--spp",
+            "2",
+            "-o",
+            exr.to_str().expect("utf-8"),
+        ];
+        let out = covtrace(&args);
+        assert!(out.status.success(), "{name}");
+        assert!(
+            !String::from_utf8_lossy(&out.stdout).contains("warning"),
+            "{name}"
+        );
+        String::from_utf8_lossy(&out.stderr).into_owned()
+    };
+    let e = stderr(file.to_str().expect("utf-8"), "upward_light");
+    assert!(e.contains("warning: the image is black"), "{e}");
+    let e = stderr("examples/scenes/cornell.ron", "not_black");
+    assert!(!e.contains("warning"), "{e}");
 }
