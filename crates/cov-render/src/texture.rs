@@ -210,7 +210,7 @@ impl TextureMap {
                 _ => Err("not a PNG or EXR image (the formats textures are read from)".to_string()),
             }
         };
-        // A header whose size passes the decoder's own memory limit fails there already.
+        // A header whose size exceeds the decoder's own memory limit fails there already.
         let (w, h) = open()?.into_dimensions().map_err(|e| match e {
             image::ImageError::Limits(_) => {
                 format!(
@@ -631,8 +631,8 @@ mod tests {
     /// Between two levels the statistics are interpolated, as the colour is: a footprint
     /// growing by 5% of a level at a time changes them by a fraction of the two levels'
     /// difference, never by the jump from one level to the next (the nearer level alone
-    /// jumped from 11.5 to 5.76 halfway between levels 3 and 4 here, and to 0 between 4 and 5), and at a level's own
-    /// footprint they are that level's.
+    /// jumped from 11.5 to 5.76 halfway between levels 3 and 4 here, and to 0 between 4
+    /// and 5), and at a level's own footprint they are that level's.
     #[test]
     fn the_statistics_do_not_jump_between_levels() {
         let t =
