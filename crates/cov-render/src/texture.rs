@@ -210,23 +210,43 @@ impl TextureMap {
                 _ => Err("not a PNG or EXR image (the formats textures are read from)".to_string()),
             }
         };
-        // A header whose size exceeds the decoder's own memory limit fails there already.
-        let (w, h) = open()?.into_dimensions().map_err(|e| match e {
-            image::ImageError::Limits(_) => {
-                format!(
+        let first = open()?;
+        let exr = matches!(first.format(), Some(image::ImageFormat::OpenExr));
+        // Where the image library cannot read an EXR (one grey channel `Y`), its header
+        // gives the size.
+        let exr_size = || {
+            let meta = exr::meta::MetaData::read_from_file(path, false).ok()?;
+            let size = meta.headers.first()?.layer_size;
+            Some((u32::try_from(size.0).ok()?, u32::try_from(size.1).ok()?))
+        };
+        let (w, h) = match first.into_dimensions() {
+            Ok(d) => d,
+            // A header whose size exceeds the decoder's own memory limit fails there already.
+            Err(image::ImageError::Limits(_)) => {
+                return Err(format!(
                     "the image is larger than textures are read, up to {MAX_TEXTURE_SIDE} texels per side"
-                )
+                ));
             }
-            e => one(&e),
-        })?;
+            Err(e) if exr => exr_size().ok_or_else(|| one(&e))?,
+            Err(e) => return Err(one(&e)),
+        };
         if w == 0 || h == 0 || w > MAX_TEXTURE_SIDE || h > MAX_TEXTURE_SIDE {
             return Err(format!(
                 "the image is {w}x{h}; texture images are read up to {MAX_TEXTURE_SIDE} texels per side"
             ));
         }
         let reader = open()?;
-        let linear = matches!(reader.format(), Some(image::ImageFormat::OpenExr));
-        let img = reader.decode().map_err(|e| one(&e))?.into_rgb32f();
+        let linear = exr;
+        let img = match reader.decode() {
+            Ok(img) => img.into_rgb32f(),
+            // An EXR of one grey channel `Y`, which the image library does not decode.
+            Err(e) if exr => {
+                let grey = grey_exr(path)
+                    .ok_or_else(|| format!("{} (an EXR texture needs R, G and B channels, or Y)", one(&e)))?;
+                return Self::from_rgb(w, h, grey, repeat);
+            }
+            Err(e) => return Err(one(&e)),
+        };
         let srgb = |c: f32| {
             if c <= 0.04045 {
                 c / 12.92
@@ -337,6 +357,20 @@ impl TextureMap {
             }
         })
     }
+}
+
+/// The texels of an EXR file's first layer as grey colours, where it has a channel `Y`
+/// (luminance, as a greyscale EXR stores it); `None` where it has none or cannot be read.
+/// Its size was checked from its header.
+fn grey_exr(path: &Path) -> Option<Vec<[f32; 3]>> {
+    let image = exr::prelude::read_first_flat_layer_from_file(path).ok()?;
+    let y = image
+        .layer_data
+        .channel_data
+        .list
+        .iter()
+        .find(|c| c.name.to_string() == "Y")?;
+    Some(y.sample_data.values_as_f32().map(|v| [v; 3]).collect())
 }
 
 /// Largest side of the grid of lookups [`TextureMap::moments`] spreads over a region.
@@ -656,6 +690,35 @@ mod tests {
             sweep.iter().all(|g| (lo - 1e-9..=hi + 1e-9).contains(g)),
             "{sweep:?}"
         );
+    }
+
+    /// A greyscale EXR (one channel `Y`, which the image library does not read) is read
+    /// as grey, linear, right way up: its top row is the texture's top (`v` near 1).
+    #[test]
+    fn a_greyscale_exr_is_read() {
+        use exr::prelude::*;
+        let dir = std::env::temp_dir().join(format!("covtrace-grey-exr-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).expect("temp dir");
+        let path = dir.join("y.exr");
+        // 4 × 2 texels: the top row 0.75, the bottom row 0.25.
+        let (w, h) = (4usize, 2usize);
+        let layer = Layer::new(
+            (w, h),
+            LayerAttributes::named(""),
+            Encoding::FAST_LOSSLESS,
+            SpecificChannels::build()
+                .with_channel("Y")
+                .with_pixel_fn(|p: Vec2<usize>| (if p.y() == 0 { 0.75f32 } else { 0.25f32 },)),
+        );
+        Image::from_layer(layer)
+            .write()
+            .to_file(&path)
+            .expect("write EXR");
+        let t = TextureMap::load(&path, DVec2::ONE).expect("a Y-only EXR loads");
+        assert_eq!(t.size(), (4, 2));
+        assert_eq!(t.rgb(DVec2::new(0.375, 0.75), 0.0), DVec3::splat(0.75));
+        assert_eq!(t.rgb(DVec2::new(0.375, 0.25), 0.0), DVec3::splat(0.25));
+        std::fs::remove_dir_all(&dir).expect("clean up");
     }
 
     #[test]
