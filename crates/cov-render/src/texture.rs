@@ -193,7 +193,7 @@ impl TextureMap {
     }
 
     /// A texture from a PNG (8 or 16 bit, sRGB-encoded, decoded to linear) or an EXR
-    /// (linear) file.
+    /// (linear; R, G and B channels, or one grey channel `Y`) file.
     ///
     /// # Errors
     /// An unreadable or undecodable file, or an image larger than [`MAX_TEXTURE_SIDE`].
@@ -236,7 +236,6 @@ impl TextureMap {
             ));
         }
         let reader = open()?;
-        let linear = exr;
         let img = match reader.decode() {
             Ok(img) => img.into_rgb32f(),
             // An EXR of one grey channel `Y`, which the image library does not decode.
@@ -256,7 +255,7 @@ impl TextureMap {
         };
         let rgb = img
             .pixels()
-            .map(|p| if linear { p.0 } else { p.0.map(srgb) })
+            .map(|p| if exr { p.0 } else { p.0.map(srgb) })
             .collect();
         Self::from_rgb(w, h, rgb, repeat)
     }

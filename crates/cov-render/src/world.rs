@@ -940,15 +940,24 @@ fn large_enough(desc: &SceneFile) -> Result<(), Failure> {
             return Err((
                 ordinal,
                 format!(
-                    "this {what} is {} m; at least {} m here ({:e} of 1 m + its distance along an axis from the origin): smaller, rays leaving it skip it and its arithmetic loses its digits",
+                    "this {what} is {} m; {}: smaller, rays leaving it skip it and its arithmetic loses its digits",
                     cov_core::num(size),
-                    cov_core::num(least),
-                    crate::geometry::MIN_SIZE
+                    at_least(least)
                 ),
             ));
         }
     }
     Ok(())
+}
+
+/// The words of a size check that failed: the least size `least` (m,
+/// [`crate::geometry::min_size`]) and how it is made.
+fn at_least(least: f64) -> String {
+    format!(
+        "at least {} m here ({:e} of 1 m + its distance along an axis from the origin)",
+        cov_core::num(least),
+        crate::geometry::MIN_SIZE
+    )
 }
 
 /// `Err` at `ordinal` if a primitive of `prims[from..]` reaches past [`MAX_COORD`] over
@@ -1028,13 +1037,17 @@ fn shapes(
                     .map_err(|e| (obj.ordinal, format!("OBJ `{}`: {e}", crate::echo(&obj.value))))?;
                 triangles += tris.len();
                 let (t, sc) = (translate.map_or(DVec3::ZERO, v), scale.map_or(1.0, |s| s.0));
-                // As a sphere's radius or a quad's edge: the mesh's extent, scaled, against
-                // the least size where it is placed.
-                let (lo, hi) = tris
+                let placed: Vec<ObjTriangle> = tris
+                    .into_iter()
+                    .map(|(p, n, uv)| (p.map(|q| q * sc + t), n, uv))
+                    .collect();
+                // As a sphere's radius or a quad's edge: the mesh's extent, placed, against
+                // the least size where it is.
+                let (lo, hi) = placed
                     .iter()
                     .flat_map(|(p, _, _)| p.iter())
                     .fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(lo, hi), &q| {
-                        (lo.min(q * sc + t), hi.max(q * sc + t))
+                        (lo.min(q), hi.max(q))
                     });
                 let (size, least) = (
                     (hi - lo).max_element(),
@@ -1044,15 +1057,14 @@ fn shapes(
                     return Err((
                         obj.ordinal,
                         format!(
-                            "this mesh is {} m across after its `scale`; at least {} m here ({:e} of 1 m + its distance along an axis from the origin)",
+                            "this mesh is {} m across after its `scale`; {}",
                             cov_core::num(size),
-                            cov_core::num(least),
-                            crate::geometry::MIN_SIZE
+                            at_least(least)
                         ),
                     ));
                 }
-                for (p, n, uv) in tris {
-                    push(Shape::triangle(p.map(|q| q * sc + t), n, uv));
+                for (p, n, uv) in placed {
+                    push(Shape::triangle(p, n, uv));
                 }
             }
         }
