@@ -140,3 +140,83 @@ fn the_sensor_reports_typed_decisions_in_the_evaluation() {
     );
     let _ = Axis::X;
 }
+
+#[derive(Debug)]
+struct Repeat(u32, f64);
+
+impl Operator for Repeat {
+    fn apply(&self, c: &mut dyn Spectrum) -> Result<(), CovError> {
+        for _ in 0..self.0 {
+            c.scale(Axis::X, self.1)?;
+        }
+        Ok(())
+    }
+}
+
+/// `Repeat(times: 2, by: 1.5)`: an integer parameter and a float one, both with a default
+/// written as a whole number.
+#[derive(Debug, OperatorSpec)]
+#[operator(summary = "a scaling repeated")]
+struct RepeatSpec {
+    /// How many times.
+    #[param(default = 2, ge = 1, le = 8)]
+    times: u32,
+    /// The scale each time.
+    #[param(default = 1, gt = 0)]
+    by: f64,
+}
+
+impl Build for RepeatSpec {
+    type Op = Repeat;
+    fn make(p: Checked<Self>) -> Result<Repeat, CovError> {
+        Ok(Repeat(p.times, p.by))
+    }
+}
+
+#[test]
+fn whole_number_parameters_take_plain_defaults_and_say_what_is_wrong() {
+    let mut registry = covtrace::registry();
+    registry.add::<RepeatSpec>();
+    let parse = |ops: &str| {
+        Path::parse(
+            &format!("Path(source: Gaussian(x: 0.5, u: 0.5),\n operators: [{ops}])"),
+            &registry,
+        )
+    };
+    // `default = 2` on a `u32` and `default = 1` on an `f64` are plain literals.
+    let e = parse("Repeat").unwrap().eval().unwrap();
+    let bare = e.result.get(0, 0);
+    let e = parse("Repeat(times: 2, by: 1.0)").unwrap().eval().unwrap();
+    assert_eq!(e.result.get(0, 0), bare);
+    // A value of the wrong type names its parameter, points at it and gives its domain,
+    // at the top level and inside a nested list.
+    for (ops, want) in [
+        (
+            "Repeat(times: -1)",
+            ":2:21: Repeat: parameter `times` = -1 is out of range: must be in [1, 8]",
+        ),
+        (
+            "Repeat(times: 9)",
+            ":2:21: Repeat: parameter `times` = 9 is out of range: must be in [1, 8]",
+        ),
+        (
+            "Repeat(by: \"two\")",
+            ":2:21: Repeat: parameter `by` = \"two\": expected a number, > 0",
+        ),
+        (
+            "Repeat(times: true)",
+            ":2:21: Repeat: parameter `times` = true: expected a whole number, in [1, 8]",
+        ),
+        (
+            "Moving(velocity: [0.1], operators: [Repeat(by: \"two\")])",
+            ":2:57: Moving: Repeat: parameter `by` = \"two\": expected a number, > 0",
+        ),
+        (
+            "Moving(velocity: [0.1], operators: [Repeat(tims: 2)])",
+            ":2:57: Moving: Repeat: unknown parameter `tims`; the parameter is either `times` or `by`",
+        ),
+    ] {
+        let err = parse(ops).unwrap_err().to_string();
+        assert!(err.contains(want), "{ops}: {err}");
+    }
+}

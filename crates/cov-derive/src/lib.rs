@@ -10,7 +10,7 @@
 //! | `#[operator(summary = "…")]` | struct | one line for `covtrace list` (required) |
 //! | `/// text` | field | the parameter's documentation |
 //! | `#[param(unit = "m")]` | field | its unit (default: none) |
-//! | `#[param(default)]`, `#[param(default = expr)]` | field | optional, with `Default::default()` or `expr` |
+//! | `#[param(default)]`, `#[param(default = expr)]` | field | optional, with `Default::default()` or `expr` (taken as the field's type for a number: `default = 2` on a `u32`) |
 //! | `#[param(nested)]` | field | a `Chain` written as an operator list (read with the caller's registry) |
 //! | `#[param(positive)]`, `#[param(non_negative)]` | field | domain `> 0`, `≥ 0` |
 //! | `#[param(gt = a, le = b)]` (and `ge`, `lt`) | field | bounds; `a`, `b` are numbers or other fields (`gt = self.focal_length`) |
@@ -161,6 +161,24 @@ fn domain_text(f: &FieldSpec) -> String {
         ),
         (Some((k, b)), None) | (None, Some((k, b))) => format!("{} {}", k.symbol(), bound_text(b)),
         (None, None) => "finite".to_string(),
+    }
+}
+
+/// A declared default of a field of type `ty`. A primitive integer takes the expression
+/// as a value of its type, so that `default = 1` means `1u32` for a `u32` (a literal out of
+/// its range is a compile error); a float takes it `as` its type (`default = 1` is `1.0`);
+/// any other type converts it with `Into` (a `&str` into a `String`, say).
+fn default_expr(ty: &syn::Type, e: &Expr) -> Tokens {
+    let t = quote!(#ty).to_string().replace(' ', "");
+    match t.as_str() {
+        "f32" | "f64" => quote!(((#e) as #ty)),
+        "u8" | "u16" | "u32" | "u64" | "u128" | "usize" | "i8" | "i16" | "i32" | "i64" | "i128" | "isize" => {
+            quote!({
+                let default: #ty = #e;
+                default
+            })
+        }
+        _ => quote!(::core::convert::Into::into(#e)),
     }
 }
 
@@ -384,7 +402,7 @@ fn expand(input: &DeriveInput) -> syn::Result<Tokens> {
         })
     });
     let default_value = |f: &FieldSpec| match &f.default {
-        Some(Some(e)) => Some(quote!(::core::convert::Into::into(#e))),
+        Some(Some(e)) => Some(default_expr(&f.ty, e)),
         Some(None) => Some(quote!(::core::default::Default::default())),
         None => None,
     };

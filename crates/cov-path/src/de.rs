@@ -112,13 +112,14 @@ impl<'de> Visitor<'de> for PathSeed<'_, '_> {
                     if layout.is_some() {
                         return Err(de::Error::duplicate_field("layout"));
                     }
-                    let n: usize = map.next_value()?;
+                    // Read signed, so that a negative layout gets the same words.
+                    let n: i64 = map.next_value()?;
                     if !(2..=5).contains(&n) {
                         return Err(de::Error::custom(format!(
                             "layout must be 2 (x,u), 3 (x,u,t), 4 (x,y,u,v) or 5 (x,y,u,v,t), got {n}"
                         )));
                     }
-                    layout = Some(n);
+                    layout = Some(n as usize);
                 }
                 "source" => {
                     if source.is_some() {

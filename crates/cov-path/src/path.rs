@@ -32,15 +32,39 @@ pub fn ron_options() -> ron::Options {
 
 /// A parser error in the path author's terms, at the place it concerns: an operator's
 /// parameter out of range at that parameter (ron reports it at the operator's end); a
-/// number where a name belongs, a decimal where a whole number belongs and the parser's
-/// recursion limit in words; everything else as ron says it.
-fn explain(text: &str, line: usize, col: usize, code: &ron::Error) -> (usize, usize, String) {
+/// value of the wrong type named by its parameter, with the domain `registry` declares for
+/// it; a number where a name belongs, a decimal where a whole number belongs and the
+/// parser's recursion limit in words; everything else as ron says it.
+fn explain(
+    text: &str,
+    line: usize,
+    col: usize,
+    code: &ron::Error,
+    registry: &Registry,
+) -> (usize, usize, String) {
     let msg = code.to_string();
-    // A custom message keeps the operator's name in front (`Travel: …`).
-    let (prefix, rest) = match msg.split_once(": ") {
-        Some((op, rest)) if !op.contains(' ') => (format!("{op}: "), rest.to_string()),
-        _ => (String::new(), msg.clone()),
-    };
+    // A custom message keeps the operators' names in front (`Travel: …`, and
+    // `Moving: Travel: …` inside a nested list).
+    let mut ops: Vec<&str> = Vec::new();
+    let mut rest = msg.as_str();
+    while let Some((op, tail)) = rest.split_once(": ")
+        && !op.is_empty()
+        && !op.contains(' ')
+    {
+        ops.push(op);
+        rest = tail;
+    }
+    let prefix: String = ops.iter().map(|op| format!("{op}: ")).collect();
+    let rest = rest.to_string();
+    if let Some(found) = wrong_type(
+        text,
+        (line, col),
+        &prefix,
+        &rest,
+        ops.last().and_then(|op| registry.get(op)),
+    ) {
+        return found;
+    }
     // An operator's parameters in the path author's words rather than the parser's.
     if !prefix.is_empty()
         && let Some(words) = parameter_words(&rest)
@@ -93,6 +117,39 @@ fn explain(text: &str, line: usize, col: usize, code: &ron::Error) -> (usize, us
         return (l, c, msg);
     }
     (line, col, msg)
+}
+
+/// ron's message that a value has the wrong type, said of the parameter it was given to
+/// (`entry`: the operator's, for the parameter's declared domain), at the parameter's
+/// name, after `prefix` (the operators' names). `None` for any other message, or when the parameter cannot be found.
+fn wrong_type(
+    text: &str,
+    (line, col): (usize, usize),
+    prefix: &str,
+    rest: &str,
+    entry: Option<&crate::registry::Entry>,
+) -> Option<(usize, usize, String)> {
+    let what = match rest {
+        "Expected float" => "a number",
+        "Expected integer" => "a whole number",
+        "Integer is out of bounds" => "",
+        "Expected boolean" => "`true` or `false`",
+        "Expected string" => "a string in double quotes",
+        _ => return None,
+    };
+    let (name, (l, c), value) = crate::scan::parameter_at(text, line, col)?;
+    let domain = entry
+        .and_then(|e| e.params.iter().find(|p| p.name == name))
+        .map(|p| p.domain)
+        .filter(|d| !d.is_empty() && *d != "finite");
+    let value = cov_core::echo(&value);
+    let message = match (what, domain) {
+        ("", Some(d)) => format!("parameter `{name}` = {value} is out of range: must be {d}"),
+        ("", None) => format!("parameter `{name}` = {value} is out of range for its type"),
+        (w, Some(d)) => format!("parameter `{name}` = {value}: expected {w}, {d}"),
+        (w, None) => format!("parameter `{name}` = {value}: expected {w}"),
+    };
+    Some((l, c, format!("{prefix}{message}")))
 }
 
 /// ron's messages about a struct's fields, said of an operator's parameters: missing,
@@ -149,7 +206,8 @@ impl Path {
                 },
             )
             .map_err(|e| {
-                let (line, col, message) = explain(text, e.span.start.line, e.span.start.col, &e.code);
+                let (line, col, message) =
+                    explain(text, e.span.start.line, e.span.start.col, &e.code, registry);
                 PathError::Parse {
                     file: "<string>".into(),
                     line,

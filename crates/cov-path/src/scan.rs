@@ -143,6 +143,69 @@ pub(crate) fn field_position(text: &str, line: usize, col: usize, name: &str) ->
     Some(pos[at])
 }
 
+/// The parameter whose value ron stopped at, `(line, col)` being in that value or just
+/// before it (ron reports a value of the wrong type there): the nearest `name:` before
+/// the position at the same bracket level, its position, and the value as written (at most
+/// 40 characters). `None` when no such `name:` stands between the position and the
+/// bracket that opens its level.
+pub(crate) fn parameter_at(text: &str, line: usize, col: usize) -> Option<(String, (usize, usize), String)> {
+    let chars: Vec<char> = text.chars().collect();
+    let pos = char_positions(&chars);
+    let at = pos.iter().position(|&p| p >= (line, col)).unwrap_or(chars.len());
+    let mut depth = 0usize;
+    let mut i = at;
+    let colon = loop {
+        if i == 0 {
+            return None;
+        }
+        i -= 1;
+        match chars[i] {
+            ')' | ']' | '}' => depth += 1,
+            '(' | '[' | '{' if depth == 0 => return None,
+            '(' | '[' | '{' => depth -= 1,
+            ':' if depth == 0 => break i,
+            _ => {}
+        }
+    };
+    let mut end = colon;
+    while end > 0 && chars[end - 1].is_whitespace() {
+        end -= 1;
+    }
+    let mut start = end;
+    while start > 0 && (chars[start - 1].is_alphanumeric() || chars[start - 1] == '_') {
+        start -= 1;
+    }
+    if start == end || !(chars[start].is_alphabetic() || chars[start] == '_') {
+        return None;
+    }
+    let name: String = chars[start..end].iter().collect();
+    // The value: from the first character after the colon to the comma or bracket that
+    // ends it at its own level.
+    let mut v = colon + 1;
+    while v < chars.len() && chars[v].is_whitespace() {
+        v += 1;
+    }
+    let mut depth = 0usize;
+    let mut w = v;
+    while w < chars.len() {
+        match chars[w] {
+            '(' | '[' | '{' => depth += 1,
+            ')' | ']' | '}' if depth == 0 => break,
+            ')' | ']' | '}' => depth -= 1,
+            ',' | '\n' if depth == 0 => break,
+            _ => {}
+        }
+        w += 1;
+    }
+    let value: String = chars[v..w]
+        .iter()
+        .take(40)
+        .collect::<String>()
+        .trim_end()
+        .to_string();
+    Some((name, pos[start], value))
+}
+
 /// Every element of every operator list, in the order of the text.
 pub(crate) fn operator_elements(text: &str) -> Vec<Element> {
     let chars: Vec<char> = text.chars().collect();

@@ -44,10 +44,11 @@ impl Build for SparkleSpec {
         if !window.is_finite() {
             return Err(SparkleSpec::FLAKE.error(p.flake, "too small: 1/(4π² flake²) overflows"));
         }
-        Ok(Sparkle {
-            window,
-            lobe: 1.0 / (FOUR_PI_SQ * p.spread),
-        })
+        let lobe = 1.0 / (FOUR_PI_SQ * p.spread);
+        if !lobe.is_finite() {
+            return Err(SparkleSpec::SPREAD.error(p.spread, "too small: 1/(4π² spread) overflows"));
+        }
+        Ok(Sparkle { window, lobe })
     }
 }
 

@@ -43,6 +43,18 @@ fn bad_sparkle_parameter_is_positioned() {
     let err = covtrace_sparkle::Sparkle::new(0.0, 1.0).expect_err("flake must be > 0");
     assert_eq!(err.to_string(), "Sparkle: parameter `flake` = 0 is out of range: must be > 0");
     assert!(covtrace_sparkle::Sparkle::new(1e-3, f64::NAN).is_err());
+    // A spread inside its domain whose lobe overflows is named as written, not as the
+    // kernel's argument.
+    let err = covtrace::path::Path::parse(
+        "Path(source: Gaussian(x: 0.1), operators: [Sparkle(flake: 0.001, spread: 1e-320)])",
+        &registry,
+    )
+    .expect_err("the lobe overflows");
+    assert!(
+        err.to_string()
+            .contains("Sparkle: parameter `spread` = 1e-320 is out of range: too small"),
+        "{err}"
+    );
 }
 
 /// The operator in every layout (2 to 5) and both forms of Σ, against its closed form:
