@@ -106,7 +106,7 @@ macro_rules! say {
 
 /// Writes a line to standard output. A closed pipe (`covtrace list | head`) ends the output
 /// quietly; any other failure (a full disk, `> /dev/full`) is an error.
-fn emit(line: &str) -> Result<(), String> {
+pub(crate) fn emit(line: &str) -> Result<(), String> {
     use std::io::Write;
     let mut out = std::io::stdout().lock();
     match writeln!(out, "{line}").and_then(|()| out.flush()) {
@@ -130,7 +130,15 @@ fn one_line_usage_error(e: &clap::Error) -> String {
             l.strip_prefix("tip: ").unwrap_or(l).to_string()
         })
         .collect();
-    format!("{} (see --help)", parts.join("; "))
+    // A line that ends in `:` introduces the next one.
+    let mut line = String::new();
+    for p in &parts {
+        if !line.is_empty() {
+            line.push_str(if line.ends_with(':') { " " } else { "; " });
+        }
+        line.push_str(p);
+    }
+    format!("{line} (see --help)")
 }
 
 /// Largest block (bytes) glibc serves from its heap rather than from a mapping of its own:

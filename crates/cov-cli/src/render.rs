@@ -60,7 +60,7 @@ pub struct RenderArgs {
     /// Render only part I of N (`I/N`, e.g. `2/4`) and write it as a part file (EXR) for
     /// `covtrace merge`: a job array renders the parts, one merge makes the image, which is
     /// the image of `--parts N` in one process.
-    #[arg(long, value_parser = parse_part)]
+    #[arg(long, value_parser = parse_part, allow_hyphen_values = true)]
     pub part: Option<Part>,
     /// Split the allocation of samples into N parts of the rows, each spending its own
     /// pixels' share of the budget, as a render in N parts does (default 1: the budget is
@@ -386,18 +386,41 @@ pub fn run(a: &RenderArgs) -> Result<String, String> {
     }
     let world = load(&a.scene, a.size)?;
     let index = a.part.map_or(1, |p| p.index);
-    cov_render::renderer::part_rows(world.camera.height, index, settings.parts).map_err(said)?;
+    cov_render::renderer::part_rows(world.camera.height, index, settings.parts).map_err(|e| {
+        match a.part {
+            // The count came with the part: say so of `--part`.
+            Some(p) => {
+                let (h, tile) = (world.camera.height, cov_render::film::TILE);
+                format!(
+                    "--part {p}: this image's {h} rows make {} tile rows of {tile}, so it splits into 1 to {} parts, not {}",
+                    h.div_ceil(tile),
+                    h.div_ceil(tile),
+                    p.count
+                )
+            }
+            None => said(e),
+        }
+    })?;
     match (a.frame, a.frames) {
         (_, Some((first, last))) => {
-            let mut world = world;
-            let mut out = String::new();
-            for k in first..=last {
-                // One scene, retimed for each frame.
-                world = world.at_frame(k).map_err(said)?;
-                out.push_str(&format!("frame {k}:\n"));
-                out.push_str(&render_one(a, &settings, &world, &frame_path(&a.output, k))?);
+            // Every frame checked before any is rendered (the two ends bound the rest).
+            for k in [first, last] {
+                if let Some(expected) = world.frame_problem(k) {
+                    return Err(format!(
+                        "--frames {first}..{last}: frame {k} is out of range: must be {expected}"
+                    ));
+                }
             }
-            Ok(out)
+            let mut world = world;
+            for k in first..last {
+                // One scene, retimed for each frame; each frame's report as it is done.
+                world = world.at_frame(k).map_err(said)?;
+                let report = render_one(a, &settings, &world, &frame_path(&a.output, k))?;
+                crate::cli::emit(&format!("frame {k}:\n{}", report.trim_end()))?;
+            }
+            let world = world.at_frame(last).map_err(said)?;
+            let report = render_one(a, &settings, &world, &frame_path(&a.output, last))?;
+            Ok(format!("frame {last}:\n{report}"))
         }
         (k, None) => {
             let world = world.at_frame(k.unwrap_or(0)).map_err(said)?;
@@ -590,7 +613,7 @@ pub fn merge(a: &MergeArgs) -> Result<String, String> {
     }
     let k = &m.key;
     let mut out = format!(
-        "render: {}×{} px, frame {}, {} at {} spp, seed {}, in {} parts\n",
+        "render: {}×{} px, frame {}, {} at {} spp, seed {}, in {} part{}\n",
         k.width,
         k.height,
         k.frame,
@@ -598,7 +621,8 @@ pub fn merge(a: &MergeArgs) -> Result<String, String> {
             .with_denoiser(cov_render::denoise::Denoise::from_name(&k.denoise).unwrap_or_default()),
         k.spp,
         k.seed,
-        k.parts
+        k.parts,
+        if k.parts == 1 { "" } else { "s" }
     );
     let mut sorted: Vec<&PartFilm> = parts.iter().collect();
     sorted.sort_by_key(|p| p.part.index);

@@ -130,7 +130,11 @@ fn bad_part_options_get_one_line() {
         (vec!["--part", "0/2"], "--part must be I/N"),
         (
             vec!["--part", "3/5", "--size", "40x64"],
-            "--parts must be 1 to 4 for this image",
+            "--part 3/5: this image's 64 rows make 4 tile rows of 16, so it splits into 1 to 4 parts, not 5",
+        ),
+        (
+            vec!["--part", "-1/4"],
+            "--part must be I/N with 1 ≤ I ≤ N, got `-1/4`",
         ),
         (
             vec!["--part", "1/2", "--parts", "3"],
@@ -184,4 +188,40 @@ fn frames_write_one_file_each_and_differ() {
         let f = cov_cli::render::frame_path(&out_file, k);
         assert!(f.exists(), "{} missing", f.display());
     }
+}
+
+/// `--frames` checks every frame before it renders the first: a range whose last frame
+/// carries a ball beyond the coordinate limit renders nothing and says which frame.
+#[test]
+fn frames_are_checked_before_any_is_rendered() {
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
+    let text = std::fs::read_to_string(root.join("examples/scenes/pool.ron")).expect("pool");
+    let fast = text.replacen("camera: (", "camera: (\n        frame_rate: 6e-12,", 1);
+    assert_ne!(fast, text, "the camera gets a frame rate");
+    let scene = tmp("fast.ron");
+    std::fs::write(&scene, fast).expect("scene");
+    let out_file = tmp("fast.exr");
+    let out = covtrace(&[
+        "render",
+        s(&scene),
+        "--frames",
+        "0..2",
+        "--size",
+        "24x16",
+        "--spp",
+        "2",
+        "-o",
+        s(&out_file),
+    ]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert!(
+        err.contains("--frames 0..2: frame 2 is out of range: must be a frame at which every shape and the camera stay within"),
+        "{err}"
+    );
+    assert!(out.stdout.is_empty());
+    assert!(
+        !cov_cli::render::frame_path(&out_file, 0).exists(),
+        "no frame was rendered"
+    );
 }

@@ -37,7 +37,8 @@
 //! its bits), so that nothing is rounded; `R`, `G`, `B` (`f32`) preview the part's pixels.
 //! A JSON key of the scene (a hash of its file and of every file it reads), the size, the
 //! frame and the settings is stored in the header, so that parts of different renders are
-//! never mixed.
+//! never mixed, with a digest of the part's data (FNV-1a of every count and every `f64`'s
+//! bits), so that a file damaged after it was written is refused, not merged.
 //!
 //! **Merging** ([`merge`]) checks that the parts share one key and cover every row once,
 //! assembles the film and the maps, and reconstructs the image as the single render does
@@ -62,8 +63,9 @@ use crate::{RenderError, World};
 
 pub use crate::renderer::MAX_PARTS;
 /// Version of the part file's layout and key (3: covariance tracing followed by a
-/// denoiser below 3 spp carries no covariance layer; 4: the film's `lum.top`).
-pub const FORMAT: u32 = 4;
+/// denoiser below 3 spp carries no covariance layer; 4: the film's `lum.top`; 5: the
+/// digest of the data in the header).
+pub const FORMAT: u32 = 5;
 /// Most channels a layer of a part file may hold (the film's holds 36: a count, a
 /// preview's R, G, B and two per sum; the maps' 10).
 const MAX_CHANNELS: usize = 64;
@@ -321,6 +323,28 @@ impl PartFilm {
     pub fn samples(&self) -> u64 {
         self.film.count.iter().map(|&c| u64::from(c)).sum()
     }
+
+    /// A digest of what the part file stores of its film and maps: FNV-1a (64 bits) of
+    /// every count and of the bits of every `f64` sum, in the file's channel order.
+    pub fn digest(&self) -> u64 {
+        use std::hash::Hasher;
+        let mut h = fnv::FnvHasher::default();
+        let n = self.film.count.len();
+        for &c in &self.film.count {
+            h.write_u32(c);
+        }
+        for (_, get, _) in FILM_FIELDS {
+            for i in 0..n {
+                h.write_u64(get(&self.film, i).to_bits());
+            }
+        }
+        for m in self.maps.iter().flatten() {
+            for (_, get, _) in MAP_FIELDS {
+                h.write_u64(get(m).to_bits());
+            }
+        }
+        h.finish()
+    }
 }
 
 /// A per-pixel `f64` of a film: its channel name, how to read it and how to write it.
@@ -384,6 +408,8 @@ struct PartInfo {
     layout: usize,
     /// Seconds: covariance, sampling, allocation.
     timing: [f64; 3],
+    /// [`PartFilm::digest`] of the data, in hex.
+    digest: String,
 }
 
 impl PartFilm {
@@ -447,6 +473,7 @@ impl PartFilm {
                 self.timing.sampling,
                 self.timing.allocation,
             ],
+            digest: format!("{:016x}", self.digest()),
         };
         let json = |v: std::result::Result<String, serde_json::Error>| -> std::result::Result<AttributeValue, RenderError> {
             let t = v.map_err(|e| RenderError::file(path, e))?;
@@ -474,6 +501,13 @@ impl PartFilm {
     pub fn read(path: &Path) -> Result<PartFilm, RenderError> {
         use exr::prelude::*;
         let bad = |m: String| RenderError::file(path, m);
+        match std::fs::metadata(path) {
+            Err(e) if e.kind() == std::io::ErrorKind::NotFound => {
+                return Err(bad("no such file".into()));
+            }
+            Ok(m) if m.is_dir() => return Err(bad("a directory, not a part file".into())),
+            _ => {}
+        }
         let meta = exr::meta::MetaData::read_from_file(path, false)
             .map_err(|e| bad(format!("not a readable OpenEXR file ({e})")))?;
         let text = |h: &exr::meta::header::Header, name: &str| -> Option<String> {
@@ -595,7 +629,7 @@ impl PartFilm {
             None
         };
         let [covariance, sampling, allocation] = info.timing;
-        Ok(PartFilm {
+        let found = PartFilm {
             key,
             part,
             rows,
@@ -609,7 +643,15 @@ impl PartFilm {
                 ..Timing::default()
             },
             source: crate::echo(&path.display().to_string()),
-        })
+        };
+        let digest = format!("{:016x}", found.digest());
+        if digest != info.digest {
+            return Err(bad(format!(
+                "its data do not match the digest it was written with ({digest} against {}): the file was changed or damaged after it was written; render the part again",
+                crate::echo(&info.digest)
+            )));
+        }
+        Ok(found)
     }
 }
 

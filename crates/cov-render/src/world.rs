@@ -333,32 +333,39 @@ impl World {
     /// 0); up to [`MAX_FRAME`].
     ///
     /// # Errors
-    /// A frame above [`MAX_FRAME`].
+    /// A frame above [`MAX_FRAME`], or one that moves a shape or the camera beyond
+    /// [`MAX_COORD`] ([`World::frame_problem`]).
     pub fn at_frame(mut self, frame: u32) -> Result<World, crate::RenderError> {
-        if frame > MAX_FRAME {
-            return Err(crate::RenderError::setting(
-                "frame",
-                format!("0 to {MAX_FRAME}"),
-                frame,
-            ));
+        if let Some(expected) = self.frame_problem(frame) {
+            return Err(crate::RenderError::setting("frame", expected, frame));
         }
         let c = &mut self.camera;
         c.time_offset = f64::from(frame) / c.frame_rate;
         let (t0, t1) = c.shutter.unwrap_or((0.0, 0.0));
         let (t0, t1) = (t0 + c.time_offset, t1 + c.time_offset);
-        let reach = self.geometry.reach(t0, t1).max(c.reach(t0, t1));
-        if reach > MAX_COORD {
-            return Err(crate::RenderError::setting(
-                "frame",
-                format!(
-                    "a frame at which every shape and the camera stay within ±{MAX_COORD:e} m (this one moves one to {reach:e} m)"
-                ),
-                frame,
-            ));
-        }
         self.geometry = self.geometry.retimed(t0, t1);
         self.frame = frame;
         Ok(self)
+    }
+
+    /// What frame `frame` would have to be instead, `None` when it can be rendered: at most
+    /// [`MAX_FRAME`], and a frame at which every shape and the camera stay within
+    /// [`MAX_COORD`]. Motion is linear in time, so the first and the last frame of a range
+    /// bound every frame between them.
+    pub fn frame_problem(&self, frame: u32) -> Option<String> {
+        if frame > MAX_FRAME {
+            return Some(format!("0 to {MAX_FRAME}"));
+        }
+        let c = &self.camera;
+        let offset = f64::from(frame) / c.frame_rate;
+        let (t0, t1) = c.shutter.unwrap_or((0.0, 0.0));
+        let (t0, t1) = (t0 + offset, t1 + offset);
+        let reach = self.geometry.reach(t0, t1).max(c.reach(t0, t1));
+        (reach > MAX_COORD).then(|| {
+            format!(
+                "a frame at which every shape and the camera stay within ±{MAX_COORD:e} m (this one moves one to {reach:e} m)"
+            )
+        })
     }
 
     /// The material at a surface hit, its albedo multiplied by its texture's colour there,

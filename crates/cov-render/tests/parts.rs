@@ -188,11 +188,29 @@ fn bad_parts_are_refused_with_one_line() {
         (&cut, "cannot read its pixels"),
         (&foreign, "not a covtrace part file"),
         (&text, "not a readable OpenEXR file"),
-        (&temp("absent.exr"), "not a readable OpenEXR file"),
+        (&temp("absent.exr"), "no such file"),
+        (&std::env::temp_dir(), "a directory, not a part file"),
     ] {
         let m = line(PartFilm::read(path).unwrap_err());
         assert!(m.contains(want), "{m}");
     }
+    // A byte of the pixel data changed after the file was written: every such file is
+    // refused, most by the digest of the data (the compressed blocks still decode).
+    let (mut refused, mut by_digest) = (0, 0);
+    let damaged = temp("damaged.exr");
+    let flips: Vec<usize> = (1..=40).map(|k| bytes.len() - k * bytes.len() / 100).collect();
+    for &at in &flips {
+        let mut b = bytes.clone();
+        b[at] ^= 0x40;
+        std::fs::write(&damaged, &b).unwrap();
+        if let Err(e) = PartFilm::read(&damaged) {
+            refused += 1;
+            by_digest += usize::from(line(e).contains("do not match the digest it was written with"));
+        }
+    }
+    let _ = std::fs::remove_file(&damaged);
+    assert_eq!(refused, flips.len(), "every damaged file is refused");
+    assert!(by_digest > 0, "some damage decodes, and the digest refuses it");
     for p in [f, cut, foreign, text] {
         let _ = std::fs::remove_file(p);
     }
