@@ -559,6 +559,15 @@ impl PartFilm {
         }
         let (method, denoise) = key.method_and_denoiser().map_err(bad)?;
         let reads = reads_covariance(method, denoise, key.spp, false);
+        if (reads && !(2..=5).contains(&info.layout)) || (!reads && info.layout != 0) {
+            return Err(bad(format!(
+                "a damaged part header: layout {} (a part of `{}` at {} spp has {})",
+                info.layout,
+                method.with_denoiser(denoise),
+                key.spp,
+                if reads { "2 to 5" } else { "0, no covariance maps" }
+            )));
+        }
         let layers = if reads { 2 } else { 1 };
         let (w, h) = (key.width as usize, rows.len());
         if meta.headers.len() != layers

@@ -209,6 +209,13 @@ fn bad_parts_are_refused_with_one_line() {
         }
     }
     let _ = std::fs::remove_file(&damaged);
+    // A header whose covariance layout is not one (the data intact).
+    let mut odd = ps[0].clone();
+    odd.layout = 9;
+    odd.write(&damaged).unwrap();
+    let m = line(PartFilm::read(&damaged).unwrap_err());
+    assert!(m.contains("a damaged part header: layout 9"), "{m}");
+    let _ = std::fs::remove_file(&damaged);
     assert_eq!(refused, flips.len(), "every damaged file is refused");
     assert!(by_digest > 0, "some damage decodes, and the digest refuses it");
     for p in [f, cut, foreign, text] {

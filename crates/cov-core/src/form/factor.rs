@@ -178,7 +178,7 @@ impl<const N: usize> CovFactor<N> {
                 c.set(i, j, self.dot(i, j));
             }
         }
-        c.check_finite("CovFactor::to_cov")?;
+        c.check_finite("Σ")?;
         Ok(c)
     }
 
