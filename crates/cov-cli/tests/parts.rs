@@ -161,21 +161,26 @@ fn bad_part_options_get_one_line() {
     }
 }
 
-#[test]
-fn frames_write_one_file_each_and_differ() {
-    let out_file = tmp("anim.exr");
-    let out = covtrace(&[
+/// `covtrace render SCENE --frames RANGE` at 24×16 px and 2 spp, to `out`.
+fn render_frames(scene: &str, range: &str, out: &std::path::Path) -> std::process::Output {
+    covtrace(&[
         "render",
-        SCENE,
+        scene,
         "--frames",
-        "0..1",
+        range,
         "--size",
         "24x16",
         "--spp",
         "2",
         "-o",
-        s(&out_file),
-    ]);
+        s(out),
+    ])
+}
+
+#[test]
+fn frames_write_one_file_each_and_differ() {
+    let out_file = tmp("anim.exr");
+    let out = render_frames(SCENE, "0..1", &out_file);
     let text = String::from_utf8_lossy(&out.stdout);
     assert!(out.status.success(), "{text}");
     let digests: Vec<&str> = text
@@ -201,18 +206,7 @@ fn frames_are_checked_before_any_is_rendered() {
     let scene = tmp("fast.ron");
     std::fs::write(&scene, fast).expect("scene");
     let out_file = tmp("fast.exr");
-    let out = covtrace(&[
-        "render",
-        s(&scene),
-        "--frames",
-        "0..2",
-        "--size",
-        "24x16",
-        "--spp",
-        "2",
-        "-o",
-        s(&out_file),
-    ]);
+    let out = render_frames(s(&scene), "0..2", &out_file);
     let err = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(2), "{err}");
     assert!(

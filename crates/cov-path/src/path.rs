@@ -129,15 +129,8 @@ fn wrong_type(
     rest: &str,
     entry: Option<&crate::registry::Entry>,
 ) -> Option<(usize, usize, String)> {
-    let what = match rest {
-        "Expected float" => "a number",
-        "Expected integer" => "a whole number",
-        "Integer is out of bounds" => "",
-        "Expected boolean" => "`true` or `false`",
-        "Expected string" => "a string in double quotes",
-        _ => return None,
-    };
-    let (name, (l, c), value) = crate::scan::parameter_at(text, line, col)?;
+    let what = expected_value(rest)?;
+    let (name, (l, c), value) = crate::scan::field_at(text, line, col)?;
     let domain = entry
         .and_then(|e| e.params.iter().find(|p| p.name == name))
         .map(|p| p.domain)
@@ -150,6 +143,21 @@ fn wrong_type(
         (w, None) => format!("parameter `{name}` = {value}: expected {w}"),
     };
     Some((l, c, format!("{prefix}{message}")))
+}
+
+/// What ron's message that a value has the wrong type says was expected, in a file
+/// author's words (`Expected float`: "a number"); "" for a whole number outside its
+/// type's range (`Integer is out of bounds`); `None` for any other message. Paths and
+/// scenes name the field with [`crate::field_at`].
+pub fn expected_value(ron_message: &str) -> Option<&'static str> {
+    Some(match ron_message {
+        "Expected float" => "a number",
+        "Expected integer" => "a whole number",
+        "Integer is out of bounds" => "",
+        "Expected boolean" => "`true` or `false`",
+        "Expected string" => "a string in double quotes",
+        _ => return None,
+    })
 }
 
 /// ron's messages about a struct's fields, said of an operator's parameters: missing,

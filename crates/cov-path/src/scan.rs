@@ -143,15 +143,31 @@ pub(crate) fn field_position(text: &str, line: usize, col: usize, name: &str) ->
     Some(pos[at])
 }
 
-/// The parameter whose value ron stopped at, `(line, col)` being in that value or just
-/// before it (ron reports a value of the wrong type there): the nearest `name:` before
-/// the position at the same bracket level, its position, and the value as written (at most
-/// 40 characters). `None` when no such `name:` stands between the position and the
-/// bracket that opens its level.
-pub(crate) fn parameter_at(text: &str, line: usize, col: usize) -> Option<(String, (usize, usize), String)> {
+/// The field whose value ron stopped at in RON `text` (a path's or a scene's), `(line,
+/// col)` (1-based, as ron reports it) being in that value or just before it, where ron
+/// reports a value of the wrong type, or at the closing parenthesis of a tuple it
+/// refused: the nearest `name:` before the value at its own bracket level, the name's
+/// position, and the value as written (at most 40 characters). `None` when no `name:`
+/// stands between the position and the bracket that opens its level (an entry of a
+/// list). A leading byte-order mark is not counted, as ron does not count it.
+pub fn field_at(text: &str, line: usize, col: usize) -> Option<(String, (usize, usize), String)> {
+    let text = text.strip_prefix('\u{feff}').unwrap_or(text);
     let chars: Vec<char> = text.chars().collect();
     let pos = char_positions(&chars);
-    let at = pos.iter().position(|&p| p >= (line, col)).unwrap_or(chars.len());
+    let mut at = pos.iter().position(|&p| p >= (line, col)).unwrap_or(chars.len());
+    // A tuple refused at its closing parenthesis: its field precedes the opening one.
+    if chars.get(at) == Some(&')') {
+        let mut depth = 0usize;
+        while at > 0 {
+            at -= 1;
+            match chars[at] {
+                ')' => depth += 1,
+                '(' if depth == 0 => break,
+                '(' => depth -= 1,
+                _ => {}
+            }
+        }
+    }
     let mut depth = 0usize;
     let mut i = at;
     let colon = loop {

@@ -545,44 +545,6 @@ fn found_at(text: &str, line: usize, col: usize) -> String {
     format!("`{token}`")
 }
 
-/// The field whose value the parser refused at `line:col` (1-based, as it reports it) in
-/// `text`: the identifier before the `:` that precedes the value (a tuple is reported at
-/// its closing parenthesis, and its field precedes the opening one). `None` where the
-/// value is not a field's (an entry of a list).
-fn field_before(text: &str, line: usize, col: usize) -> Option<&str> {
-    let text = text.strip_prefix('\u{feff}').unwrap_or(text);
-    let start = line_start(text, line)?;
-    let row = text.get(start..)?;
-    let at = row
-        .char_indices()
-        .nth(col.checked_sub(1)?)
-        .map_or(row.len(), |(i, _)| i);
-    let mut end = start + at;
-    // A tuple is refused at its closing parenthesis: its field precedes the opening one.
-    if text[end..].starts_with(')') {
-        let mut depth = 0usize;
-        for (i, c) in text[..=end].char_indices().rev() {
-            match c {
-                ')' => depth += 1,
-                '(' if depth == 1 => {
-                    end = i;
-                    break;
-                }
-                '(' => depth = depth.checked_sub(1)?,
-                _ => {}
-            }
-        }
-    }
-    let before = text.get(..end)?.trim_end().strip_suffix(':')?.trim_end();
-    let name_start = before
-        .char_indices()
-        .rev()
-        .take_while(|(_, c)| c.is_ascii_alphanumeric() || *c == '_')
-        .last()
-        .map(|(i, _)| i)?;
-    Some(&before[name_start..])
-}
-
 impl SceneFile {
     /// Parses scene text; `file` names it in errors.
     ///
@@ -592,14 +554,25 @@ impl SceneFile {
         Self::parse_probed(text, None).map_err(|e| {
             let (line, col) = (e.span.start.line, e.span.start.col);
             let mut message = e.code.to_string();
+            let field = || cov_path::field_at(text, line, col);
             // A value the checked types refused: name its field, as the user wrote it.
             if let ron::Error::Message(m) = &e.code
-                && let Some(name) = field_before(text, line, col)
+                && let Some((name, ..)) = field()
             {
                 message = if m.starts_with("must be ") {
                     format!("`{name}` {m}")
                 } else {
                     format!("`{name}`: {m}")
+                };
+            } else if let Some(what) = cov_path::expected_value(&message)
+                && let Some((name, _, value)) = field()
+            {
+                // A value of the wrong type: its field, what it holds and what it needs.
+                let value = cov_core::echo(&value);
+                message = if what.is_empty() {
+                    format!("`{name}` = {value} is out of range for a whole number")
+                } else {
+                    format!("`{name}` = {value}: expected {what}")
                 };
             } else if message.starts_with("Expected") {
                 // A syntax error: say what stands where something else was expected.

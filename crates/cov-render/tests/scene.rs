@@ -459,6 +459,11 @@ fn a_syntax_error_says_what_it_found() {
     assert!(e.ends_with("Expected comma, found `o`"), "{e}");
     let e = error(&scene(&[("FOV", "40.0 width")]));
     assert!(e.ends_with("Expected comma, found `width`"), "{e}");
+    // A value of the wrong type names its field and what it needs.
+    let e = error(&scene(&[("FOV", "\"wide\"")]));
+    assert!(e.ends_with("`fov` = \"wide\": expected a number"), "{e}");
+    let e = error(&scene(&[("FOV", "true")]));
+    assert!(e.ends_with("`fov` = true: expected a number"), "{e}");
 }
 
 /// OBJ files a new user brought: a byte-order mark and a Latin-1 comment are read past;
