@@ -6,7 +6,8 @@
 //! Writes into the output folder: `results.csv`, `results.json`, `error_time.png` and
 //! `.svg` (relMSE against seconds, log–log), `strip.png` (each method at about equal
 //! time beside the reference) and `reference.png`. The reference is cached as
-//! `reference-<key>.exr`, keyed by the scene text, size, reference spp and seed.
+//! `reference-<key>.exr`, keyed by the scene's fingerprint (its text and every file it
+//! reads: textures, meshes), size, reference spp and seed.
 
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
@@ -53,7 +54,8 @@ pub const MAX_BUDGETS: usize = 12;
 pub struct BenchArgs {
     /// The scene file.
     pub scene: PathBuf,
-    /// Average samples per pixel of each run, comma-separated (1 to 65536 each).
+    /// Average samples per pixel of each run, comma-separated (whole numbers, 1 to 65536
+    /// each; sorted, a repeated one run once).
     #[arg(long, value_delimiter = ',', default_values_t = [2.0, 4.0, 8.0, 16.0, 32.0])]
     pub budgets: Vec<f64>,
     /// Methods, comma-separated (default: all): uniform, gauss, variance, cov-density,
@@ -192,9 +194,11 @@ fn check_args(a: &BenchArgs) -> Result<(Vec<Variant>, Vec<f64>), String> {
         ));
     }
     for &b in &a.budgets {
-        if !(b.is_finite() && (1.0..=f64::from(MAX_SPP)).contains(&b)) {
+        // Whole numbers, as `covtrace render --spp` takes, so that every run can be
+        // rendered again on its own.
+        if !(b.is_finite() && (1.0..=f64::from(MAX_SPP)).contains(&b) && b.fract() == 0.0) {
             return Err(format!(
-                "--budgets: each must be 1 to {MAX_SPP} samples per pixel, got {b}"
+                "--budgets: each must be a whole number of samples per pixel, 1 to {MAX_SPP}, got {b}"
             ));
         }
     }
@@ -231,19 +235,19 @@ fn folder(dir: &Path, what: &str) -> Result<(), String> {
 }
 
 /// The reference image: from the cache when there, else rendered and cached.
-fn reference(
-    a: &BenchArgs,
-    world: &World,
-    text: &[u8],
-    cache: &Path,
-) -> Result<(cov_render::Image, String), String> {
+fn reference(a: &BenchArgs, world: &World, cache: &Path) -> Result<(cov_render::Image, String), String> {
     let (w, h) = (world.camera.width, world.camera.height);
     // The version names the path tracer's estimator: v2 combines light and BRDF sampling
     // at a glossy second vertex, whose references lack v1's fireflies; v3 maps textures on
-    // spheres unmirrored.
+    // spheres unmirrored; v4 keys the scene by its fingerprint, so that a texture or a
+    // mesh changed under the same scene text is a new reference.
     let key = fnv(
-        format!("covtrace-reference-v3 {w}x{h} {} {}", a.ref_spp, a.seed).as_bytes(),
-        fnv(text, 0xcbf2_9ce4_8422_2325),
+        format!(
+            "covtrace-reference-v4 {w}x{h} {} {} {:016x}",
+            a.ref_spp, a.seed, world.fingerprint
+        )
+        .as_bytes(),
+        0xcbf2_9ce4_8422_2325,
     );
     let exr = cache.join(format!("reference-{key:016x}.exr"));
     if let Ok(img) = read_image(&exr)
@@ -283,9 +287,6 @@ pub fn bench(a: &BenchArgs) -> Result<String, String> {
     let cache = a.cache.clone().unwrap_or_else(|| a.output.clone());
     folder(&cache, "cache folder")?;
     let world = crate::render::load(&a.scene, a.size)?;
-    // The scene's text keys the cached reference; read as the scene was, within its bound.
-    let text = cov_render::world::read_bounded(&a.scene, cov_render::scene::MAX_SCENE_BYTES, "scene")
-        .map_err(|e| format!("{}: {e}", crate::render::shown(&a.scene)))?;
     // What the run writes in the output folder must not be what it reads.
     let mut written: Vec<std::path::PathBuf> = [
         "results.csv",
@@ -325,7 +326,7 @@ pub fn bench(a: &BenchArgs) -> Result<String, String> {
     // The runs' settings checked against the scene (`--parts` against its rows) before
     // the reference, which may take minutes.
     Renderer::new(&world, settings(Variant::UNIFORM, budgets[0], 1)).map_err(crate::render::said)?;
-    let (reference, line) = reference(a, &world, &text, &cache)?;
+    let (reference, line) = reference(a, &world, &cache)?;
     out.push_str(&line);
     out.push('\n');
     cov_render::output::save(tonemap(&reference), &a.output.join("reference.png"))

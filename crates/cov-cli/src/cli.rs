@@ -127,7 +127,7 @@ fn one_line_usage_error(e: &clap::Error) -> String {
         .filter(|l| !l.is_empty() && !l.starts_with("For more information"))
         .map(|l| {
             let l = l.strip_prefix("error: ").unwrap_or(l);
-            l.strip_prefix("tip: ").unwrap_or(l).to_string()
+            whole_number_words(l.strip_prefix("tip: ").unwrap_or(l))
         })
         .collect();
     // A line that ends in `:` introduces the next one.
@@ -139,6 +139,25 @@ fn one_line_usage_error(e: &clap::Error) -> String {
         line.push_str(p);
     }
     format!("{line} (see --help)")
+}
+
+/// Rust's messages for a whole-number option that does not parse, in a user's words: a
+/// decimal or an exponent (`1.5`, `1e9`) is "not a whole number", and a negative value
+/// for an unsigned option is "below 0" rather than outside the type's range.
+fn whole_number_words(line: &str) -> String {
+    let line = line
+        .replace("invalid digit found in string", "expected a whole number")
+        .replace(
+            "cannot parse integer from empty string",
+            "expected a whole number",
+        )
+        .replace("number too large to fit in target type", "too large");
+    match line.split_once(": -") {
+        Some((head, tail)) if tail.contains(" is not in 0..=") => {
+            format!("{head}: expected a whole number ≥ 0")
+        }
+        _ => line,
+    }
 }
 
 /// Largest block (bytes) glibc serves from its heap rather than from a mapping of its own:

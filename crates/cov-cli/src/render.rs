@@ -220,11 +220,12 @@ pub fn parse_size(s: &str) -> Result<(u32, u32), String> {
     let max = cov_render::scene::MAX_RESOLUTION;
     let bad = || {
         format!(
-            "--size must be WIDTHxHEIGHT with sides 1 to {max}, got `{}`",
+            "--size must be WIDTHxHEIGHT (or WIDTH×HEIGHT) with sides 1 to {max}, got `{}`",
             cov_render::echo(s)
         )
     };
-    let (w, h) = s.split_once(['x', 'X']).ok_or_else(bad)?;
+    // `×` too, as the reports print sizes.
+    let (w, h) = s.split_once(['x', 'X', '×']).ok_or_else(bad)?;
     let (w, h) = (
         w.trim().parse::<u32>().map_err(|_| bad())?,
         h.trim().parse::<u32>().map_err(|_| bad())?,
@@ -391,10 +392,10 @@ pub fn run(a: &RenderArgs) -> Result<String, String> {
             // The count came with the part: say so of `--part`.
             Some(p) => {
                 let (h, tile) = (world.camera.height, cov_render::film::TILE);
+                let rows = h.div_ceil(tile);
+                let (s, sp) = if rows == 1 { ("", "") } else { ("s", "s") };
                 format!(
-                    "--part {p}: this image's {h} rows make {} tile rows of {tile}, so it splits into 1 to {} parts, not {}",
-                    h.div_ceil(tile),
-                    h.div_ceil(tile),
+                    "--part {p}: this image's {h} rows make {rows} tile row{s} of {tile}, so it splits into 1 to {rows} part{sp}, not {}",
                     p.count
                 )
             }
@@ -492,10 +493,25 @@ fn render_one(
     let reached = match a.time {
         None => String::new(),
         Some(t) => format!(
-            "; {} pass(es) of {} spp in the {t} s asked, {:.1} spp on average reached",
+            "; {} pass{} of {} spp in the {} s asked, {:.1} spp on average reached{}",
             r.passes,
+            if r.passes == 1 { "" } else { "es" },
             a.spp,
-            r.samples as f64 / n
+            // As typed, unless its decimals would run on (1e-300).
+            if (1e-3..1e6).contains(&t) {
+                t.to_string()
+            } else {
+                format!("{t:e}")
+            },
+            r.samples as f64 / n,
+            if r.capped {
+                format!(
+                    " (stopped before the time: every pixel holds {} samples, the most a pixel takes)",
+                    cov_render::film::MAX_SPP
+                )
+            } else {
+                String::new()
+            }
         ),
     };
     out.push_str(&format!("image digest: {:016x}\n", r.image.digest()));

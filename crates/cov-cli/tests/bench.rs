@@ -63,9 +63,16 @@ fn a_tiny_bench_writes_every_output_and_caches_its_reference() {
 
 #[test]
 fn bad_arguments_give_one_line() {
-    let cases: [(&[&str], &str); 6] = [
-        (&["--budgets", "0"], "--budgets: each must be 1 to 65536"),
-        (&["--budgets", "nan"], "--budgets: each must be 1 to 65536"),
+    let cases: [(&[&str], &str); 7] = [
+        (
+            &["--budgets", "0"],
+            "--budgets: each must be a whole number of samples per pixel, 1 to 65536",
+        ),
+        (&["--budgets", "nan"], "--budgets: each must be a whole number"),
+        (
+            &["--budgets", "2,1.5"],
+            "--budgets: each must be a whole number of samples per pixel, 1 to 65536, got 1.5",
+        ),
         (&["--methods", "cov,magic"], "unknown method `magic`"),
         (&["--cov-stride", "3"], "--cov-stride must be one of"),
         (&["--ref-spp", "0"], "--ref-spp must be 1 to 65536"),
@@ -167,4 +174,44 @@ fn zero_radiance(text: &str) -> String {
     }
     out.push_str(rest);
     out
+}
+
+/// The cached reference is keyed by the files a scene reads as well as its text: a
+/// texture changed under the same scene text renders a new reference.
+#[test]
+fn a_changed_texture_is_a_new_reference() {
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/scenes");
+    let dir = common::tmp("bench", "texture");
+    std::fs::create_dir_all(dir.join("textures")).expect("folder");
+    std::fs::copy(root.join("snooker.ron"), dir.join("snooker.ron")).expect("scene");
+    for f in std::fs::read_dir(root.join("textures"))
+        .expect("textures")
+        .flatten()
+    {
+        std::fs::copy(f.path(), dir.join("textures").join(f.file_name())).expect("texture");
+    }
+    let scene = dir.join("snooker.ron");
+    let out = dir.join("out");
+    let run = || {
+        let o = covtrace(&[
+            "render-bench",
+            scene.to_str().expect("utf-8"),
+            "--size",
+            "16x12",
+            "--ref-spp",
+            "4",
+            "--budgets",
+            "2",
+            "--methods",
+            "uniform",
+            "-o",
+            out.to_str().expect("utf-8"),
+        ]);
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        String::from_utf8_lossy(&o.stdout).contains("(cached)")
+    };
+    assert!(!run(), "the first run renders its reference");
+    assert!(run(), "the second finds it");
+    std::fs::copy(root.join("textures/ball12.png"), dir.join("textures/ball9.png")).expect("texture");
+    assert!(!run(), "a changed texture is a new reference");
 }

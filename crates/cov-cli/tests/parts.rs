@@ -143,7 +143,7 @@ fn bad_part_options_get_one_line() {
         (vec!["--parts", "0"], "'--parts <PARTS>': 0 is not in 1..=512"),
         (
             vec!["--parts", "9", "--size", "40x64"],
-            "--parts must be 1 to 4 for this image (its 64 rows make 4 tile rows of 16), with 1 ≤ part ≤ parts, got 9",
+            "--parts must be 1 to 4 for this image (its 64 rows make 4 tile rows of 16), got 9",
         ),
         (
             vec!["--part", "1/2", "--time", "1"],

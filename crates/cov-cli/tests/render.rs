@@ -237,7 +237,7 @@ fn time_renders_progressively_and_says_what_it_reached() {
         &["--spp", "1", "--time", "1"],
     );
     let passes: u32 = out
-        .split(" pass(es) of 1 spp in the 1 s asked")
+        .split(" passes of 1 spp in the 1 s asked")
         .next()
         .and_then(|p| p.rsplit(' ').next())
         .and_then(|p| p.parse().ok())
@@ -251,6 +251,28 @@ fn time_renders_progressively_and_says_what_it_reached() {
         assert_eq!(o.status.code(), Some(2), "--time {bad}: {err}");
         assert_eq!(err.trim_end().lines().count(), 1, "{err}");
     }
+    // A render that fills every pixel to the most a pixel takes stops early and says so;
+    // the time limit's passes go on until then (16 passes of 4096 make 65536).
+    let exr = tmp("capped.exr");
+    let o = covtrace(&[
+        "render",
+        "examples/scenes/pool.ron",
+        "--size",
+        "2x2",
+        "--method",
+        "uniform",
+        "--spp",
+        "4096",
+        "--time",
+        "600",
+        "-o",
+        exr.to_str().expect("utf-8 path"),
+    ]);
+    let out = String::from_utf8_lossy(&o.stdout);
+    assert!(
+        out.contains("16 passes of 4096 spp in the 600 s asked, 65536.0 spp on average reached (stopped before the time: every pixel holds 65536 samples"),
+        "{out}"
+    );
 }
 
 /// `render --method cov --spp 16 --seed 1` writes the image that `render-bench` measures

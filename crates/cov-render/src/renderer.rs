@@ -267,6 +267,9 @@ pub struct Rendered {
     pub budget: f64,
     /// Passes rendered (1 without a time limit).
     pub passes: u32,
+    /// Whether the passes stopped before the time limit because every pixel holds
+    /// [`MAX_SPP`] samples.
+    pub capped: bool,
     /// Samples taken in all.
     pub samples: u64,
     /// The reconstructed image.
@@ -381,6 +384,7 @@ impl<'w> Renderer<'w> {
             film,
             mut timing,
             passes,
+            capped,
             cands,
         } = self.sample(&win, progress)?;
         let method = self.settings.method;
@@ -390,6 +394,7 @@ impl<'w> Renderer<'w> {
             method,
             budget: self.settings.spp,
             passes,
+            capped,
             samples: film.count.iter().map(|&c| u64::from(c)).sum(),
             image,
             film,
@@ -559,12 +564,20 @@ impl<'w> Renderer<'w> {
         }
         // More passes while the next one is expected to end within the time limit.
         let mut passes = 1u32;
+        let mut capped = false;
         if let Some(limit) = s.time {
             loop {
                 let pass_secs = timing.sampling / f64::from(passes);
-                let highest = film.count.iter().copied().max().unwrap_or(0);
                 let elapsed = start.elapsed().as_secs_f64();
-                if elapsed + pass_secs > limit || u64::from(highest) + u64::from(hi) > u64::from(MAX_SPP) {
+                if elapsed + pass_secs > limit {
+                    break;
+                }
+                // A pixel at MAX_SPP takes no more (`Film::render`); the passes go on
+                // while one of the rows' pixels has room.
+                let w = film.width as usize;
+                let rows = win.owned.start as usize * w..win.owned.end as usize * w;
+                if film.count[rows].iter().all(|&c| c >= MAX_SPP) {
+                    capped = true;
                     break;
                 }
                 if method.has_pilot() {
@@ -583,6 +596,7 @@ impl<'w> Renderer<'w> {
             film,
             timing,
             passes,
+            capped,
             cands,
         })
     }
@@ -594,6 +608,7 @@ pub(crate) struct Sampled {
     pub film: Film,
     pub timing: Timing,
     pub passes: u32,
+    pub capped: bool,
     pub cands: Vec<Vec<Gaussian>>,
 }
 
@@ -668,17 +683,19 @@ pub const MAX_PARTS: u32 = crate::scene::MAX_RESOLUTION / crate::film::TILE;
 pub fn part_rows(height: u32, index: u32, parts: u32) -> Result<Range<u32>, RenderError> {
     let tile = crate::film::TILE;
     let rows = height.div_ceil(tile);
-    if index == 0 || index > parts || parts > rows {
+    if parts == 0 || parts > rows {
+        let s = if rows == 1 { "" } else { "s" };
         return Err(RenderError::setting(
             "parts",
-            format!(
-                "1 to {rows} for this image (its {height} rows make {rows} tile rows of {tile}), with 1 ≤ part ≤ parts"
-            ),
-            if parts > rows {
-                format!("{parts}")
-            } else {
-                format!("part {index} of {parts}")
-            },
+            format!("1 to {rows} for this image (its {height} rows make {rows} tile row{s} of {tile})"),
+            parts,
+        ));
+    }
+    if index == 0 || index > parts {
+        return Err(RenderError::setting(
+            "part",
+            format!("1 to {parts} of {parts}"),
+            format!("part {index} of {parts}"),
         ));
     }
     let at = |k: u32| (u64::from(k) * u64::from(rows) / u64::from(parts)) as u32 * tile;

@@ -574,7 +574,7 @@ impl SceneFile {
                 } else {
                     format!("`{name}` = {value}: expected {what}")
                 };
-            } else if message.starts_with("Expected") {
+            } else if message.starts_with("Expected") && !message.contains(" found ") {
                 // A syntax error: say what stands where something else was expected.
                 message = format!("{message}, found {}", found_at(text, line, col));
             }
