@@ -453,13 +453,14 @@ pub fn bench(a: &BenchArgs) -> Result<String, String> {
     out.push_str(&summary(&rows, &methods, &budgets));
     let _ = writeln!(
         out,
-        "equal-time strip (≈{target:.2} s per image): {}\nwrote {}, {}, {}, {}, {}",
+        "equal-time strip (≈{target:.2} s per image): {}\nwrote {}, {}, {}, {}, {}, reference.png and, per method, METHOD.exr, METHOD.png and METHOD.error.png in {}",
         picked,
         a.output.join("results.csv").display(),
         a.output.join("results.json").display(),
         chart.display(),
         chart.with_extension("svg").display(),
-        strip.display()
+        strip.display(),
+        a.output.display()
     );
     Ok(out)
 }

@@ -814,7 +814,10 @@ pub fn check(a: &CheckArgs) -> Result<String, String> {
             "n/a (none)".to_string()
         },
         t = cov_render::validate::T,
-    ))
+    ) + &a
+        .json
+        .as_ref()
+        .map_or(String::new(), |j| format!("\nwrote {}", shown(j))))
 }
 
 /// A number for a report: three significant digits, `n/a` when undefined.
