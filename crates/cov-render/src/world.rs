@@ -410,7 +410,15 @@ impl World {
             }
         })?;
         let dir = path.parent().unwrap_or(Path::new("."));
-        Self::from_text(&text, &file, dir)
+        Self::from_text(&text, &file, dir).map_err(|e| {
+            // A mesh given where a scene belongs: say so rather than what RON expected.
+            let obj = path.extension().is_some_and(|x| x.eq_ignore_ascii_case("obj"));
+            if obj {
+                err("an OBJ mesh, not a scene: a scene (`Scene(...)` in RON) places it with a `Mesh(obj: \"…\", material: …)` shape".into())
+            } else {
+                e
+            }
+        })
     }
 
     /// Builds a scene from text; `file` names it in errors and `dir` is where OBJ paths

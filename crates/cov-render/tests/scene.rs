@@ -531,3 +531,11 @@ fn obj_files_say_what_is_wrong_with_them() {
     }
     std::fs::remove_dir_all(&dir).expect("clean up");
 }
+
+/// An OBJ mesh given where a scene belongs says so, not what the RON parser expected.
+#[test]
+fn a_mesh_given_as_the_scene_says_so() {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/scenes/torus.obj");
+    let e = cov_render::World::load(&path).unwrap_err().to_string();
+    assert!(e.ends_with("an OBJ mesh, not a scene: a scene (`Scene(...)` in RON) places it with a `Mesh(obj: \"…\", material: …)` shape"), "{e}");
+}
