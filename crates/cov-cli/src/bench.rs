@@ -641,6 +641,9 @@ impl Picture for ErrorChart<'_> {
             .y_desc("relMSE against the reference")
             .label_style(("sans-serif", 13))
             .axis_desc_style(("sans-serif", 13))
+            // The log axes' minor lines bunch towards each decade: the ticks' lines alone.
+            .light_line_style(TRANSPARENT)
+            .bold_line_style(RGBColor(215, 215, 215))
             .draw()?;
         let font = ("sans-serif", 14).into_font().color(&BLACK);
         right.draw(&Text::new("method", (6, 40), font.clone()))?;
