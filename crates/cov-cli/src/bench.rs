@@ -60,7 +60,8 @@ pub struct BenchArgs {
     pub budgets: Vec<f64>,
     /// Methods, comma-separated (default: all): uniform, gauss, variance, cov-density,
     /// cov-filter, cov-unguarded, cov; each may be followed by +oidn or +oidn-color (a
-    /// build with `--features oidn`).
+    /// build with `--features oidn`). Uniform sampling always runs: it is the line the
+    /// equal-error speed-ups are read against.
     #[arg(long, value_delimiter = ',')]
     pub methods: Vec<String>,
     /// Samples per pixel of the reference.
@@ -234,8 +235,8 @@ fn folder(dir: &Path, what: &str) -> Result<(), String> {
     crate::render::check_output(&dir.join("probe.json"), "json")
 }
 
-/// The reference image: from the cache when there, else rendered and cached.
-fn reference(a: &BenchArgs, world: &World, cache: &Path) -> Result<(cov_render::Image, String), String> {
+/// The cached reference's file, and its image when the cache holds a sound one.
+fn cached(a: &BenchArgs, world: &World, cache: &Path) -> (PathBuf, Option<cov_render::Image>) {
     let (w, h) = (world.camera.width, world.camera.height);
     // The version names the path tracer's estimator: v2 combines light and BRDF sampling
     // at a glossy second vertex, whose references lack v1's fireflies; v3 maps textures on
@@ -250,10 +251,19 @@ fn reference(a: &BenchArgs, world: &World, cache: &Path) -> Result<(cov_render::
         0xcbf2_9ce4_8422_2325,
     );
     let exr = cache.join(format!("reference-{key:016x}.exr"));
-    if let Ok(img) = read_image(&exr)
-        && (img.width, img.height) == (w, h)
-        && img.pixels.iter().all(|p| p.is_finite())
-    {
+    let img = read_image(&exr)
+        .ok()
+        .filter(|img| (img.width, img.height) == (w, h) && img.pixels.iter().all(|p| p.is_finite()));
+    (exr, img)
+}
+
+/// The reference image: the cached one (`cached`), else rendered and cached as `exr`.
+fn reference(
+    a: &BenchArgs,
+    world: &World,
+    (exr, cached): (PathBuf, Option<cov_render::Image>),
+) -> Result<(cov_render::Image, String), String> {
+    if let Some(img) = cached {
         return Ok((img, format!("reference: {} (cached)", exr.display())));
     }
     let b = bar(tile_count(world), "reference");
@@ -285,8 +295,12 @@ pub fn bench(a: &BenchArgs) -> Result<String, String> {
     let (methods, budgets) = check_args(a)?;
     folder(&a.output, "output folder")?;
     let cache = a.cache.clone().unwrap_or_else(|| a.output.clone());
-    folder(&cache, "cache folder")?;
     let world = crate::render::load(&a.scene, a.size)?;
+    // The cache must take a new reference, unless it holds this one (it may be read-only).
+    let found = cached(a, &world, &cache);
+    if found.1.is_none() {
+        folder(&cache, "cache folder")?;
+    }
     // What the run writes in the output folder must not be what it reads.
     let mut written: Vec<std::path::PathBuf> = [
         "results.csv",
@@ -326,7 +340,7 @@ pub fn bench(a: &BenchArgs) -> Result<String, String> {
     // The runs' settings checked against the scene (`--parts` against its rows) before
     // the reference, which may take minutes.
     Renderer::new(&world, settings(Variant::UNIFORM, budgets[0], 1)).map_err(crate::render::said)?;
-    let (reference, line) = reference(a, &world, &cache)?;
+    let (reference, line) = reference(a, &world, found)?;
     out.push_str(&line);
     out.push('\n');
     cov_render::output::save(tonemap(&reference), &a.output.join("reference.png"))
