@@ -392,7 +392,7 @@ pub fn run(a: &RenderArgs) -> Result<String, String> {
             // The count came with the part: say so of `--part`.
             Some(p) => {
                 let (h, tile) = (world.camera.height, cov_render::film::TILE);
-                let rows = h.div_ceil(tile);
+                let rows = cov_render::renderer::tile_rows(h);
                 let (s, sp) = if rows == 1 { ("", "") } else { ("s", "s") };
                 format!(
                     "--part {p}: this image's {h} rows make {rows} tile row{s} of {tile}, so it splits into 1 to {rows} part{sp}, not {}",
@@ -412,16 +412,22 @@ pub fn run(a: &RenderArgs) -> Result<String, String> {
                     ));
                 }
             }
+            // One scene, retimed for each frame; each frame's report printed as it is
+            // done, the last one returned.
             let mut world = world;
-            for k in first..last {
-                // One scene, retimed for each frame; each frame's report as it is done.
+            let mut k = first;
+            loop {
                 world = world.at_frame(k).map_err(said)?;
-                let report = render_one(a, &settings, &world, &frame_path(&a.output, k))?;
-                crate::cli::emit(&format!("frame {k}:\n{}", report.trim_end()))?;
+                let report = format!(
+                    "frame {k}:\n{}",
+                    render_one(a, &settings, &world, &frame_path(&a.output, k))?
+                );
+                if k == last {
+                    return Ok(report);
+                }
+                crate::cli::emit(report.trim_end())?;
+                k += 1;
             }
-            let world = world.at_frame(last).map_err(said)?;
-            let report = render_one(a, &settings, &world, &frame_path(&a.output, last))?;
-            Ok(format!("frame {last}:\n{report}"))
         }
         (k, None) => {
             let world = world.at_frame(k.unwrap_or(0)).map_err(said)?;

@@ -670,6 +670,12 @@ pub fn check_memory(
     ))
 }
 
+/// The tile rows ([`crate::film::TILE`] px each, the last one possibly shorter) of an image
+/// of `height` rows: the most parts it splits into ([`part_rows`]).
+pub fn tile_rows(height: u32) -> u32 {
+    height.div_ceil(crate::film::TILE)
+}
+
 /// Most parts a render splits into ([`RenderSettings::parts`]): one per tile row of the
 /// tallest image.
 pub const MAX_PARTS: u32 = crate::scene::MAX_RESOLUTION / crate::film::TILE;
@@ -682,7 +688,7 @@ pub const MAX_PARTS: u32 = crate::scene::MAX_RESOLUTION / crate::film::TILE;
 /// `index` outside `1..=parts`, or more parts than the image has tile rows.
 pub fn part_rows(height: u32, index: u32, parts: u32) -> Result<Range<u32>, RenderError> {
     let tile = crate::film::TILE;
-    let rows = height.div_ceil(tile);
+    let rows = tile_rows(height);
     if parts == 0 || parts > rows {
         let s = if rows == 1 { "" } else { "s" };
         return Err(RenderError::setting(
@@ -908,6 +914,8 @@ impl Timing {
 
 #[cfg(test)]
 mod tests {
+    use super::*;
+
     /// A render whose peak would exceed the memory available is refused before it starts,
     /// in one line naming the size, the method, the need and what is available; one that
     /// fits, or a machine that does not say, passes.
@@ -925,8 +933,6 @@ mod tests {
         assert!(check_memory(256, 192, Method::Cov, Some(100_000_000)).is_ok());
         assert!(check_memory(8192, 8192, Method::Cov, None).is_ok());
     }
-
-    use super::*;
 
     /// Only covariance tracing followed by a denoiser, with no pilot and no time limit,
     /// leaves Σ unread.

@@ -339,13 +339,20 @@ impl World {
         if let Some(expected) = self.frame_problem(frame) {
             return Err(crate::RenderError::setting("frame", expected, frame));
         }
-        let c = &mut self.camera;
-        c.time_offset = f64::from(frame) / c.frame_rate;
-        let (t0, t1) = c.shutter.unwrap_or((0.0, 0.0));
-        let (t0, t1) = (t0 + c.time_offset, t1 + c.time_offset);
+        let (offset, t0, t1) = self.frame_times(frame);
+        self.camera.time_offset = offset;
         self.geometry = self.geometry.retimed(t0, t1);
         self.frame = frame;
         Ok(self)
+    }
+
+    /// Frame `frame`'s time offset (`frame / frame_rate`) and its shutter (or a still's
+    /// instant), moved by it.
+    fn frame_times(&self, frame: u32) -> (f64, f64, f64) {
+        let c = &self.camera;
+        let offset = f64::from(frame) / c.frame_rate;
+        let (t0, t1) = c.shutter.unwrap_or((0.0, 0.0));
+        (offset, t0 + offset, t1 + offset)
     }
 
     /// What frame `frame` would have to be instead, `None` when it can be rendered: at most
@@ -356,11 +363,8 @@ impl World {
         if frame > MAX_FRAME {
             return Some(format!("0 to {MAX_FRAME}"));
         }
-        let c = &self.camera;
-        let offset = f64::from(frame) / c.frame_rate;
-        let (t0, t1) = c.shutter.unwrap_or((0.0, 0.0));
-        let (t0, t1) = (t0 + offset, t1 + offset);
-        let reach = self.geometry.reach(t0, t1).max(c.reach(t0, t1));
+        let (_, t0, t1) = self.frame_times(frame);
+        let reach = self.geometry.reach(t0, t1).max(self.camera.reach(t0, t1));
         (reach > MAX_COORD).then(|| {
             format!(
                 "a frame at which every shape and the camera stay within ±{MAX_COORD:e} m (this one moves one to {reach:e} m)"
