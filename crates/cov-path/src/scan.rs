@@ -25,6 +25,35 @@ pub(crate) struct Element {
 /// a backstop that is never reached.
 pub const MAX_NESTING: usize = 16;
 
+/// `chars` with every comment blanked (its line breaks kept) and every string's contents
+/// replaced by `x`, so that brackets, colons and commas written there do not count as
+/// the file's structure; every character keeps its position.
+fn code_of(chars: &[char]) -> Vec<char> {
+    let mut out = chars.to_vec();
+    let mut i = 0;
+    while i < chars.len() {
+        if let Some(next) = skip_comment(chars, i) {
+            for c in &mut out[i..next.min(chars.len())] {
+                if *c != '\n' {
+                    *c = ' ';
+                }
+            }
+            i = next;
+        } else if chars[i] == '"' {
+            let next = skip_string(chars, i).min(chars.len());
+            for c in &mut out[i + 1..next.saturating_sub(1).max(i + 1)] {
+                if *c != '\n' {
+                    *c = 'x';
+                }
+            }
+            i = next;
+        } else {
+            i += 1;
+        }
+    }
+    out
+}
+
 /// `(line, col)`, 1-based, of every character of `chars`.
 fn char_positions(chars: &[char]) -> Vec<(usize, usize)> {
     let mut pos = Vec::with_capacity(chars.len());
@@ -46,7 +75,7 @@ fn char_positions(chars: &[char]) -> Vec<(usize, usize)> {
 /// of range) at its end; this finds `name:` at the operator's own level. `None` when the
 /// position is not the end of an operator or the field is not written there (a default).
 pub(crate) fn field_position(text: &str, line: usize, col: usize, name: &str) -> Option<(usize, usize)> {
-    let chars: Vec<char> = text.chars().collect();
+    let chars = code_of(&text.chars().collect::<Vec<char>>());
     let pos = char_positions(&chars);
     let mut close = pos.iter().position(|&p| p == (line, col))?;
     // ron may point just past the parenthesis.
@@ -152,7 +181,8 @@ pub(crate) fn field_position(text: &str, line: usize, col: usize, name: &str) ->
 /// list). A leading byte-order mark is not counted, as ron does not count it.
 pub fn field_at(text: &str, line: usize, col: usize) -> Option<(String, (usize, usize), String)> {
     let text = text.strip_prefix('\u{feff}').unwrap_or(text);
-    let chars: Vec<char> = text.chars().collect();
+    let written: Vec<char> = text.chars().collect();
+    let chars = code_of(&written);
     let pos = char_positions(&chars);
     let mut at = pos.iter().position(|&p| p >= (line, col)).unwrap_or(chars.len());
     // A tuple refused at its closing parenthesis: its field precedes the opening one.
@@ -213,7 +243,7 @@ pub fn field_at(text: &str, line: usize, col: usize) -> Option<(String, (usize, 
         }
         w += 1;
     }
-    let value: String = chars[v..w]
+    let value: String = written[v..w]
         .iter()
         .take(40)
         .collect::<String>()
@@ -378,6 +408,34 @@ mod tests {
         let t = "Scatter(\n  angle: 0.3,\n  phase: Tabulated(\n    angles: [0.0, 0.5, 0.2],\n    values: [1, 1, 1],\n  ),\n)";
         assert_eq!(field_position(t, 7, 1, "angles[2]"), Some((4, 24)));
         assert_eq!(field_position(t, 7, 1, "values"), Some((5, 5)));
+    }
+
+    /// Brackets, colons and commas inside comments and strings are not the file's
+    /// structure: the field is found across a comment, and a string value is shown whole.
+    #[test]
+    fn a_field_is_found_across_comments_and_strings() {
+        let at = |t: &str, needle: &str| {
+            let i = t.find(needle).unwrap();
+            let line = t[..i].matches('\n').count() + 1;
+            let col = i - t[..i].rfind('\n').map_or(0, |n| n + 1) + 1;
+            field_at(t, line, col)
+        };
+        let t = "Path(\n  operators: [Travel(distance: /* (a: b), */ \"far\")],\n)\n";
+        assert_eq!(
+            at(t, "\"far"),
+            Some(("distance".into(), (2, 22), "\"far\"".into()))
+        );
+        let t = "Scene(\n  texture: \"a,b(c).png\",\n)\n";
+        assert_eq!(
+            at(t, "\"a,b"),
+            Some(("texture".into(), (2, 3), "\"a,b(c).png\"".into()))
+        );
+        // A tuple refused at its closing parenthesis, a `(` in a string inside it.
+        let t = "Scene(size: (\"(\", 2))";
+        assert_eq!(at(t, "))"), Some(("size".into(), (1, 7), "(\"(\", 2)".into())));
+        // The field's own line holds a comment with a colon after the value.
+        let t = "Scene(\n  width: -3, // height: 2\n)";
+        assert_eq!(at(t, "-3"), Some(("width".into(), (2, 3), "-3".into())));
     }
 
     #[test]
