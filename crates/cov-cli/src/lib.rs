@@ -97,7 +97,7 @@ pub fn format_decisions(d: &covtrace::sensor::PixelDecisions) -> String {
         d.image_axes.join(",")
     ));
     out.push_str(&format!(
-        "  filter std          {} px (principal axes){}\n",
+        "  filter std          {} px (principal axes, the image's content){}\n",
         d.filter_std_px
             .iter()
             .map(|v| format!("{v:.3}"))
@@ -106,9 +106,28 @@ pub fn format_decisions(d: &covtrace::sensor::PixelDecisions) -> String {
         if d.filter_clamped { ", clamped" } else { "" }
     ));
     out.push_str(&format!("  sampled domain      {}\n", d.sampled_axes.join(" × ")));
+    // The sampled domain's unit volume: px per image axis, m per lens axis, s for time.
+    let units: Vec<&str> = d
+        .sampled_axes
+        .iter()
+        .map(|a| match a.as_str() {
+            "t" => "s",
+            a if a.starts_with("lens_") => "m",
+            _ => "px",
+        })
+        .collect();
+    let mut volume: Vec<String> = Vec::new();
+    for u in ["px", "m", "s"] {
+        match units.iter().filter(|v| **v == u).count() {
+            0 => {}
+            1 => volume.push(u.to_string()),
+            n => volume.push(format!("{u}{}", if n == 2 { "²" } else { "³" })),
+        }
+    }
     out.push_str(&format!(
-        "  density             {:.4e} samples per unit volume\n",
-        d.density
+        "  density             {:.4e} samples per {}\n",
+        d.density,
+        volume.join("·")
     ));
     out.push_str(&format!("  samples per pixel   {:.3}\n", d.samples_per_pixel));
     out

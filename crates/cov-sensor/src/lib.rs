@@ -14,9 +14,11 @@
 //!    `1/(4σ)`); samples per pixel multiply it by the domain's extent, `1 px` per image axis,
 //!    `√(2π)·aperture` per lens axis and `√(2π)·shutter` for time (the integrals of the
 //!    Gaussian windows);
-//! 4. the **reconstruction filter**: the Gaussian whose spectrum matches the image-space Σ,
-//!    primal covariance `(4π² Σ_px)⁻¹` in pixels², clamped at `max_filter` pixels where Σ
-//!    is singular.
+//! 4. the **reconstruction filter**: the Gaussian whose spectrum matches the image's
+//!    content, the image-space Σ before the pixel filter's window, primal covariance
+//!    `(4π² Σ_px)⁻¹` in pixels², clamped at `max_filter` pixels where Σ is singular. (The
+//!    window belongs to what one pixel's samples integrate, so it sets the density; with it,
+//!    no filter could be wider than the pixel filter.)
 //!
 //! The lens position `p` of a ray reaching the sensor at `x_s` with direction `u` is
 //! `p = x_s − distance·u`, the change of variables used for the lens part of the density.
@@ -40,11 +42,13 @@
 //! As an operator, `Sensor` applies the pixel filter and integrates over `u`, `v`, `t`:
 //! the path's final Σ is then the image-space covariance in metres.
 //!
-//! **Worked example** (flatland, `width = 1000`, `fov_x = 0.5`, `distance = 1`): the pitch is
-//! `2·tan(0.25)/1000 = 5.107e-4 m`. An image-space `Σ_xx = 1e5 (cycles/m)²` is
-//! `1e5 × 5.107e-4² = 0.0261 (cycles/px)²` (bandwidth 0.16 cycles/px). With the default
-//! `k = 2` that needs `4 × 0.16 = 0.65` samples per pixel, and the matching filter std is
-//! `1/(2π·0.16) = 0.99 px`.
+//! **Worked example** (flatland, `width = 1000`, `fov_x = 0.5`, `distance = 1`, the default
+//! pixel filter of 0.5 px): the pitch is `2·tan(0.25)/1000 = 5.107e-4 m`. An image-space
+//! `Σ_xx = 1e5 (cycles/m)²` is `1e5 × 5.107e-4² = 0.02608 (cycles/px)²` (bandwidth 0.16
+//! cycles/px), and the matching filter std is `1/(2π·0.1615) = 0.986 px`. The pixel filter's
+//! window adds `1/(4π²·0.5²) = 0.1013 (cycles/px)²`, so a pixel integrates a band of
+//! `√0.1274 = 0.357` cycles/px, and with the default `k = 2` that needs
+//! `4 × 0.357 = 1.43` samples per pixel.
 //!
 //! ```
 //! use cov_core::Cov;
@@ -54,11 +58,12 @@
 //! assert!((sensor.pitch() - 2.0 * 0.25f64.tan() / 1000.0).abs() < 1e-18);
 //! let at_sensor = Cov::<2>::from_diagonal([1e5, 0.0])?;
 //! let d = sensor.decisions(&at_sensor)?;
-//! assert!(d.image_bandwidth_px[0] > 0.0 && d.samples_per_pixel > 0.0);
+//! assert!((d.filter_std_px[0] - 0.986).abs() < 1e-3);
+//! assert!((d.image_bandwidth_px[0] - 0.357).abs() < 1e-3);
+//! assert!((d.samples_per_pixel - 1.428).abs() < 1e-3);
 //! # Ok::<(), cov_core::CovError>(())
 //! ```
 
-//!
 //! In RON (a path that ends at a `Sensor`; `covtrace eval` then prints the decisions):
 //!
 //! ```
@@ -165,11 +170,14 @@ pub struct PixelRates {
 pub struct PixelDecisions {
     /// Image axes (`x`, or `x, y`).
     pub image_axes: Vec<String>,
-    /// Image-space Σ in (cycles/px)², row by row.
+    /// Image-space Σ in (cycles/px)², row by row, with the pixel filter's window (the
+    /// spectrum of what a pixel's samples integrate, which sets the density).
     pub image_cov_px: Vec<Vec<f64>>,
-    /// √Σ_ii of the image, cycles per pixel.
+    /// √Σ_ii of the image, cycles per pixel (with the pixel filter's window).
     pub image_bandwidth_px: Vec<f64>,
-    /// Reconstruction filter: std along its principal axes (px), ascending.
+    /// Reconstruction filter of the image's content (Σ before the pixel filter's
+    /// window): std along its principal axes (px), ascending; `max_filter` where the
+    /// content is flat.
     pub filter_std_px: Vec<f64>,
     /// Principal directions of the filter (columns), in image axes.
     pub filter_directions: Vec<Vec<f64>>,
@@ -321,15 +329,16 @@ impl Sensor {
     /// # Errors
     /// Overflow, or an aperture/shutter given for a layout without `u`/`t`.
     pub fn decisions(&self, at_sensor: impl Into<AnyCov>) -> Result<PixelDecisions, CovError> {
-        let c: AnyCov = at_sensor.into();
+        let mut c: AnyCov = at_sensor.into();
         let r = self.rates(&c)?;
-        let mut c2 = c;
-        self.pixel_filter(c2.as_spectrum_mut())?;
-        let image_axes = c2.as_spectrum_mut().spatial_axes();
+        let image_axes = c.as_spectrum_mut().spatial_axes();
         let n_img = r.image_dims;
         let image_cov_px: Vec<Vec<f64>> = (0..n_img).map(|i| r.image_cov_px[i][..n_img].to_vec()).collect();
-        let filter = scaled_block(&c2, image_axes, self.pitch)?
-            .reconstruction_filter(&vec![self.p.max_filter; n_img])?;
+        // The filter matches the image's content, Σ before the pixel filter's window: with
+        // the window, no filter could be wider than the pixel filter itself.
+        let filter =
+            scaled_block(&c, image_axes, self.pitch)?
+                .reconstruction_filter(&vec![self.p.max_filter; n_img])?;
         let mut sampled_axes: Vec<String> = image_axes.iter().map(|a| format!("{a}_px")).collect();
         if self.p.aperture.is_some() {
             sampled_axes.extend(image_axes.iter().map(|a| format!("lens_{a}")));
@@ -441,7 +450,11 @@ impl PixelDecisions {
                 ),
                 f("filter clamped", "", Field::Flag(self.filter_clamped)),
                 f("sampled domain", "", Field::Text(self.sampled_axes.clone())),
-                f("density", "samples per unit volume", Field::Number(self.density)),
+                f(
+                    "density",
+                    "samples per px, m (lens) and s (time) of the sampled domain",
+                    Field::Number(self.density),
+                ),
                 f("samples per pixel", "", Field::Number(self.samples_per_pixel)),
             ],
             self.clone(),

@@ -29,8 +29,10 @@ fn image_space_units_and_filter() {
     let w = 1.0 / (4.0 * PI * PI * (0.5 * pitch).powi(2));
     let expected = (4e6 + w) * pitch * pitch;
     assert!((d.image_cov_px[0][0] - expected).abs() < 1e-12 * expected);
-    // Filter std = 1/(2π √Σ_px) (not clamped here).
-    assert!((d.filter_std_px[0] - 1.0 / (2.0 * PI * expected.sqrt())).abs() < 1e-12);
+    // Filter std = 1/(2π √Σ_px) of the content, before the pixel window (not clamped).
+    let content = 4e6 * pitch * pitch;
+    assert!((d.filter_std_px[0] - 1.0 / (2.0 * PI * content.sqrt())).abs() < 1e-12);
+    assert!(!d.filter_clamped);
     // Density over the image axis only: (2k) √Σ_px, k = 2; one pixel of extent.
     assert!((d.density - 4.0 * expected.sqrt()).abs() < 1e-12);
     assert_eq!(d.samples_per_pixel, d.density);
@@ -86,8 +88,13 @@ fn lens_and_time_enter_the_sampled_domain() {
 #[test]
 fn zero_spectrum_gives_the_widest_filter_and_no_nan() {
     let d = sensor(None, None).decisions(Cov::<4>::zeros()).unwrap();
-    assert!(d.filter_std_px.iter().all(|v| v.is_finite() && *v > 0.0));
+    // A flat image: the widest filter on both axes, however narrow the pixel filter.
+    assert_eq!(d.filter_std_px, [8.0, 8.0]);
+    assert!(d.filter_clamped);
     assert!(d.density.is_finite());
+    // The pixel filter's window alone sets the density: (2k)² / (4π² f²) per px².
+    let w = 1.0 / (4.0 * PI * PI * 0.25);
+    assert!((d.density - 16.0 * w).abs() < 1e-12 * d.density);
 }
 
 #[test]
