@@ -82,8 +82,9 @@ pub fn save<P: Picture>(
     Ok(())
 }
 
-/// Colours distinct on white and in greyscale (decreasing luminance), with a marker each.
-pub const COLORS: [RGBColor; 8] = [
+/// Colours distinct on white (the first eight also in greyscale, by decreasing
+/// luminance), one per series, so that no two of a chart's ten series share one.
+pub const COLORS: [RGBColor; 10] = [
     RGBColor(0, 0, 0),
     RGBColor(213, 94, 0),
     RGBColor(0, 114, 178),
@@ -92,6 +93,8 @@ pub const COLORS: [RGBColor; 8] = [
     RGBColor(86, 86, 86),
     RGBColor(230, 159, 0),
     RGBColor(120, 28, 129),
+    RGBColor(86, 180, 233),
+    RGBColor(150, 30, 30),
 ];
 
 /// Tick labels of a log axis: `1e-7`, `3e2`.

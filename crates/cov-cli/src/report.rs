@@ -105,7 +105,7 @@ pub fn cases() -> Result<Vec<Case>, covtrace::CovError> {
                 .then(Primal::scale(2, 1, 1.0 / refract.angular_scale())),
         },
         Case {
-            name: "hard blocker edge (non-Gaussian)",
+            name: "hard blocker edge",
             gaussian: false,
             chain: Chain::new().with(BlockerEdge::new(0.05)?),
             field: f0().then(Primal::Window(Arc::new(
