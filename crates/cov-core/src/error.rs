@@ -92,7 +92,7 @@ pub enum CovError {
         reason: String,
     },
     /// A step of a chain failed; wraps the error with the step index and name.
-    #[error("step {index} ({operator}): {source}")]
+    #[error("step {index} ({operator}): {}", own_words(operator, source))]
     Step {
         /// Zero-based index of the step in the chain.
         index: usize,
@@ -101,6 +101,16 @@ pub enum CovError {
         /// The error it returned.
         source: Box<CovError>,
     },
+}
+
+/// A step's error without the operator's name when it begins with it (the step already
+/// names the operator: `step 1 (Integrate): …`, not `step 1 (Integrate): Integrate: …`).
+fn own_words(operator: &str, source: &CovError) -> String {
+    let s = source.to_string();
+    match s.strip_prefix(operator).and_then(|r| r.strip_prefix(": ")) {
+        Some(rest) => rest.to_string(),
+        None => s,
+    }
 }
 
 impl CovError {

@@ -104,7 +104,9 @@ impl Build for TextureSpec {
 
 /// `ThickOccluder(depth: 0.3, slices: 4, std: 0.05)`.
 #[derive(Debug, OperatorSpec)]
-#[operator(summary = "an occluder with depth: `slices` times a window then a travel of depth/slices (its travels add up to `depth`; add none of your own across it)")]
+#[operator(
+    summary = "an occluder with depth: `slices` times a window then a travel of depth/slices (its travels add up to `depth`; add none of your own across it)"
+)]
 pub struct ThickOccluderSpec {
     /// Depth of the occluder along the ray.
     #[param(unit = "m", non_negative)]

@@ -218,8 +218,12 @@ impl<'de> Visitor<'de> for OpSeed<'_, '_> {
         let bare = reader.elements.get(ordinal).map(|e| e.bare);
         let (name, variant) = data.variant_seed(FieldName)?;
         let Some(entry) = reader.registry.get(&name) else {
+            let hint = match reader.registry.closest(&name) {
+                Some(near) => format!(" (did you mean `{near}`?)"),
+                None => String::new(),
+            };
             return Err(de::Error::custom(format!(
-                "unknown operator `{}`; known operators: {}",
+                "unknown operator `{}`{hint}; known operators: {}",
                 echo(&name),
                 reader.registry.names()
             )));

@@ -129,8 +129,8 @@ fn wrong_type(
     rest: &str,
     entry: Option<&crate::registry::Entry>,
 ) -> Option<(usize, usize, String)> {
-    let what = expected_value(rest)?;
     let (name, (l, c), value) = crate::scan::field_at(text, line, col)?;
+    let what = expected_value(rest, &value)?;
     let domain = entry
         .and_then(|e| e.params.iter().find(|p| p.name == name))
         .map(|p| p.domain)
@@ -148,9 +148,12 @@ fn wrong_type(
 /// What ron's message that a value has the wrong type says was expected, in a file
 /// author's words (`Expected float`: "a number"); "" for a whole number outside its
 /// type's range (`Integer is out of bounds`); `None` for any other message. Paths and
-/// scenes name the field with [`crate::field_at`].
-pub fn expected_value(ron_message: &str) -> Option<&'static str> {
+/// scenes name the field with [`crate::field_at`], whose value as written is `written`: a
+/// `nan` where a number was expected is said to be no finite number.
+pub fn expected_value(ron_message: &str, written: &str) -> Option<&'static str> {
+    let nan = written.trim_start_matches(['-', '+']).eq_ignore_ascii_case("nan");
     Some(match ron_message {
+        "Expected float" if nan => "a finite number, not NaN",
         "Expected float" => "a number",
         "Expected integer" => "a whole number",
         "Integer is out of bounds" => "",
@@ -164,6 +167,15 @@ pub fn expected_value(ron_message: &str) -> Option<&'static str> {
 /// unknown (with the ones it takes) and repeated. `None` for any other message.
 fn parameter_words(rest: &str) -> Option<String> {
     let name_after = |prefix: &str| rest.strip_prefix(prefix).and_then(|t| t.split_once('`'));
+    // A name outside a list of choices (an axis `w`, a lobe `Phng`).
+    if let Some((name, after)) = name_after("Unexpected enum variant named `")
+        && let Some(choices) = after
+            .strip_prefix(", expected one of ")
+            .or_else(|| after.strip_prefix(", expected "))
+            .and_then(|c| c.strip_suffix(" instead"))
+    {
+        return Some(format!("unknown name `{name}`: expected one of {choices}"));
+    }
     if let Some((name, _)) = name_after("Unexpected missing field named `") {
         return Some(format!("missing parameter `{name}`"));
     }

@@ -117,6 +117,27 @@ impl Registry {
         self.entries.keys().copied().collect::<Vec<_>>().join(", ")
     }
 
+    /// The registered name closest to `name`, when one is close enough to be what was meant:
+    /// the same letters in another case, or at most two edits away (Damerau–Levenshtein;
+    /// one for names of four letters or fewer).
+    pub fn closest(&self, name: &str) -> Option<&'static str> {
+        let lower = name.to_lowercase();
+        let near = if name.chars().count() <= 4 { 1 } else { 2 };
+        self.entries
+            .keys()
+            .map(|k| {
+                let d = if k.to_lowercase() == lower {
+                    0
+                } else {
+                    strsim::damerau_levenshtein(k, name)
+                };
+                (d, *k)
+            })
+            .filter(|(d, _)| *d <= near)
+            .min()
+            .map(|(_, k)| k)
+    }
+
     /// Number of entries.
     pub fn len(&self) -> usize {
         self.entries.len()

@@ -564,8 +564,8 @@ impl SceneFile {
                 } else {
                     format!("`{name}`: {m}")
                 };
-            } else if let Some(what) = cov_path::expected_value(&message)
-                && let Some((name, _, value)) = field()
+            } else if let Some((name, _, value)) = field()
+                && let Some(what) = cov_path::expected_value(&message, &value)
             {
                 // A value of the wrong type: its field, what it holds and what it needs.
                 let value = cov_core::echo(&value);

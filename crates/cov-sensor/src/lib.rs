@@ -492,10 +492,15 @@ impl Operator for Integrate {
     /// nothing (a renderer integrates over what it samples and keeps the image axes).
     fn apply(&self, cov: &mut dyn Spectrum) -> Result<(), CovError> {
         if cov.axes().iter().all(|a| self.axes.contains(a)) {
-            return Err(spec::IntegrateSpec::AXES.error(
-                self.axes.len() as f64,
-                "must leave at least one axis of the layout: integrating every axis leaves nothing to describe",
-            ));
+            let all: Vec<String> = cov.axes().iter().map(ToString::to_string).collect();
+            return Err(CovError::Shape {
+                what: "Integrate: axes".into(),
+                expected: "at least one axis of the layout left out".into(),
+                got: format!(
+                    "all of them ({}): integrating every axis leaves nothing to describe",
+                    all.join(", ")
+                ),
+            });
         }
         cov.integrate(&self.axes)
     }
