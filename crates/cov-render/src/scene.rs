@@ -21,11 +21,11 @@
 //!
 //! | field | unit | meaning |
 //! |---|---|---|
-//! | `camera.position`, `look_at`, `up` | m | pinhole / lens centre, aim point, up vector (default +y) |
+//! | `camera.position`, `look_at`, `up` | m | pinhole / lens centre, aim point (both within ±[`crate::geometry::MAX_COORD`]), up vector (default +y) |
 //! | `camera.fov` | degrees | horizontal field of view, from [`MIN_FOV`] (1e-6) to below 180 |
 //! | `camera.width`, `height` | px | 1 to [`MAX_RESOLUTION`] each |
 //! | `camera.lens.aperture` | m | lens radius: 0 (pinhole) or [`LENS_RANGE`] (1e-9 to 1e6) |
-//! | `camera.lens.focus_distance` | m | distance of the plane in focus, > 0 |
+//! | `camera.lens.focus_distance` | m | distance of the plane in focus, above the focal length and at most [`crate::geometry::MAX_COORD`] |
 //! | `camera.lens.focal_length` | m | focal length (default 0.05) in [`LENS_RANGE`], < focus distance |
 //! | `camera.shutter.open`, `close` | s | shutter interval, `close − open` in [`SHUTTER_RANGE`] (1e-15 to 1e6) |
 //! | `camera.velocity` | m/s | camera motion during the shutter; the camera stays within ±[`crate::geometry::MAX_COORD`] of the origin over it (and at every frame rendered) |

@@ -474,7 +474,19 @@ type Failure = (u32, String);
 /// The camera of a description.
 fn camera(c: &CameraDesc) -> Result<Camera, Failure> {
     let position = v(c.position);
-    let look = v(c.look_at.value) - position;
+    let aim = v(c.look_at.value);
+    if !(aim.abs().max_element() <= MAX_COORD) {
+        return Err((
+            c.look_at.ordinal,
+            format!(
+                "look_at must lie within ±{MAX_COORD:e} m of the origin, as every point of the scene does, got ({}, {}, {})",
+                cov_core::num(aim.x),
+                cov_core::num(aim.y),
+                cov_core::num(aim.z)
+            ),
+        ));
+    }
+    let look = aim - position;
     if look.length() <= 0.0 {
         return Err((c.look_at.ordinal, "the camera looks at its own position".into()));
     }
@@ -526,6 +538,15 @@ fn camera(c: &CameraDesc) -> Result<Camera, Failure> {
                 in_lens_range("aperture (0 for a pinhole)", r, l.aperture.ordinal)?;
             }
             let d = l.focus_distance.value.0;
+            if d > MAX_COORD {
+                return Err((
+                    l.focus_distance.ordinal,
+                    format!(
+                        "focus_distance must be at most {MAX_COORD:e} m (the scene's extent), got {}",
+                        cov_core::num(d)
+                    ),
+                ));
+            }
             if d <= f {
                 return Err((
                     l.focus_distance.ordinal,

@@ -51,10 +51,21 @@ fn error(text: &str) -> String {
 
 #[test]
 fn checks_after_parsing_point_at_the_value() {
-    let cases: [(&[(&str, &str)], &str); 9] = [
+    let cases: [(&[(&str, &str)], &str); 11] = [
         (
             &[("LOOK", "(0.0, 1.0, 3.0)")],
             "2:50: the camera looks at its own position",
+        ),
+        // Beyond the scene's extent: normalising the view direction overflowed, and the
+        // message blamed `up`.
+        (
+            &[("LOOK", "(0.0, 0.9, -1e200)")],
+            "2:50: look_at must lie within ±1e12 m of the origin",
+        ),
+        // Squared in the lens equation: past 1e154 it overflowed into a black image.
+        (
+            &[("LENS", ", lens: (aperture: 0.01, focus_distance: 1e155)")],
+            "2:138: focus_distance must be at most 1e12 m (the scene's extent), got 1e155",
         ),
         (
             &[("FOV", "180.0")],
