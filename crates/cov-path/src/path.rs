@@ -213,6 +213,18 @@ impl Path {
                 ),
             });
         }
+        if let Some(e) = elements.get(crate::scan::MAX_OPERATORS) {
+            return Err(PathError::Parse {
+                file: "<string>".into(),
+                line: e.line,
+                col: e.col,
+                message: format!(
+                    "the path holds {} operators; at most {} (this is the first one past it)",
+                    elements.len(),
+                    crate::scan::MAX_OPERATORS
+                ),
+            });
+        }
         // First pass: the declared layout, wherever it stands in the file, so that the
         // second pass can check every operator against it where it is written.
         let declared = ron_options().from_str_seed(text, LayoutProbe).ok().flatten();
