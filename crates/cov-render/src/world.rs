@@ -1026,6 +1026,8 @@ fn shapes(
 ) -> Result<bool, Failure> {
     let mut triangles = 0usize;
     let mut any_velocity = false;
+    // Each OBJ file is read once, however many meshes place it.
+    let mut read: std::collections::HashMap<std::path::PathBuf, Vec<ObjTriangle>> = Default::default();
     for s in &desc.shapes {
         let from = prims.len();
         let (material, velocity) = match s {
@@ -1073,13 +1075,23 @@ fn shapes(
                 scale,
                 ..
             } => {
-                let tris = load_obj(&dir.join(&obj.value), MAX_TRIANGLES - triangles)
-                    .map_err(|e| (obj.ordinal, format!("OBJ `{}`: {e}", crate::echo(&obj.value))))?;
+                let in_obj = |e: String| (obj.ordinal, format!("OBJ `{}`: {e}", crate::echo(&obj.value)));
+                let path = dir.join(&obj.value);
+                if !read.contains_key(&path) {
+                    let tris = load_obj(&path, MAX_TRIANGLES - triangles).map_err(in_obj)?;
+                    read.insert(path.clone(), tris);
+                }
+                let tris = read.get(&path).map_or(&[][..], Vec::as_slice);
+                if tris.len() > MAX_TRIANGLES - triangles {
+                    return Err(in_obj(format!(
+                        "more than {MAX_TRIANGLES} triangles in the scene; meshes are read up to that"
+                    )));
+                }
                 triangles += tris.len();
                 let (t, sc) = (translate.map_or(DVec3::ZERO, v), scale.map_or(1.0, |s| s.0));
                 let placed: Vec<ObjTriangle> = tris
-                    .into_iter()
-                    .map(|(p, n, uv)| (p.map(|q| q * sc + t), n, uv))
+                    .iter()
+                    .map(|&(p, n, uv)| (p.map(|q| q * sc + t), n, uv))
                     .collect();
                 // As a sphere's radius or a quad's edge: the mesh's extent, placed, against
                 // the least size where it is.
@@ -1242,8 +1254,9 @@ pub const DEFAULT_FRAME_RATE: f64 = 24.0;
 pub const MAX_FRAME: u32 = 1_000_000;
 
 /// The files a scene reads besides itself (texture images, OBJ meshes), resolved against
-/// `dir`.
+/// `dir`, each once, in the order the scene first names them.
 fn input_files(desc: &SceneFile, dir: &Path) -> Vec<std::path::PathBuf> {
+    let mut seen = std::collections::HashSet::new();
     let textures = desc.textures.values().filter_map(|t| match &t.value {
         TextureDesc::Image { file, .. } => Some(dir.join(&file.value)),
         _ => None,
@@ -1252,7 +1265,10 @@ fn input_files(desc: &SceneFile, dir: &Path) -> Vec<std::path::PathBuf> {
         ShapeDesc::Mesh { obj, .. } => Some(dir.join(&obj.value)),
         _ => None,
     });
-    textures.chain(meshes).collect()
+    textures
+        .chain(meshes)
+        .filter(|p| seen.insert(p.clone()))
+        .collect()
 }
 
 /// FNV-1a of `text` and of the bytes of `files` (a file that cannot be read adds its

@@ -550,3 +550,22 @@ fn a_mesh_given_as_the_scene_says_so() {
     let e = cov_render::World::load(&path).unwrap_err().to_string();
     assert!(e.ends_with("an OBJ mesh, not a scene: a scene (`Scene(...)` in RON) places it with a `Mesh(obj: \"…\", material: …)` shape"), "{e}");
 }
+
+/// A mesh placed several times is the file's triangles at each place (the file is read
+/// once), and the scene's fingerprint reads each file once.
+#[test]
+fn a_mesh_placed_twice_is_read_once_and_placed_twice() {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/scenes");
+    let shapes = |n: usize| {
+        (0..n)
+            .map(|i| format!(r#"Mesh(obj: "torus.obj", material: "w", translate: ({i}.0, 0.0, 0.0))"#))
+            .collect::<Vec<_>>()
+            .join(", ")
+    };
+    let world = |n: usize| World::from_text(&scene(&[("SHAPE", &shapes(n))]), "s.ron", &dir).unwrap();
+    let (none, one, three) = (world(0), world(1), world(3));
+    let mesh = one.geometry.len() - none.geometry.len();
+    assert!(mesh > 1000, "{mesh}");
+    assert_eq!(three.geometry.len() - none.geometry.len(), 3 * mesh);
+    assert_eq!(three.inputs.len(), 1);
+}
