@@ -288,6 +288,14 @@ impl Prim {
         }
     }
 
+    /// The bits of the corners of the box the BVH holds: equal for primitives whose boxes the BVH
+    /// builder cannot tell apart.
+    pub fn box_key(&self, t0: f64, t1: f64) -> [u32; 6] {
+        let b = self.aabb(t0, t1);
+        let (lo, hi) = (b.min.to_array(), b.max.to_array());
+        [lo[0], lo[1], lo[2], hi[0], hi[1], hi[2]].map(f32::to_bits)
+    }
+
     /// A box around the primitive over the times `t0..t1`, padded for f32 traversal.
     fn aabb(&self, t0: f64, t1: f64) -> Aabb {
         let (a0, b0) = self.bounds_at(t0);

@@ -446,8 +446,13 @@ impl World {
         let (t0, t1) = camera.shutter.unwrap_or((0.0, 0.0));
         let lights = lights(&desc, &mut prims).map_err(|(o, m)| at(o, m))?;
         within_reach(&prims, 0, t0, t1, desc.lights.ordinal).map_err(|(o, m)| at(o, m))?;
+        let mut boxes = SharedBoxes::default();
+        boxes
+            .add(&prims, 0, (t0, t1), desc.lights.ordinal)
+            .map_err(|(o, m)| at(o, m))?;
         let names = Names(&material_names, "material");
-        let any_velocity = shapes(&desc, &names, dir, &mut prims, (t0, t1)).map_err(|(o, m)| at(o, m))?
+        let any_velocity = shapes(&desc, &names, dir, &mut prims, (t0, t1), &mut boxes)
+            .map_err(|(o, m)| at(o, m))?
             || camera.velocity != DVec3::ZERO;
         large_enough(&desc).map_err(|(o, m)| at(o, m))?;
         let inputs = input_files(&desc, dir);
@@ -1015,14 +1020,54 @@ fn within_reach(prims: &[Prim], from: usize, t0: f64, t1: f64, ordinal: u32) -> 
     ))
 }
 
+/// Most primitives (shapes, lights, a mesh's triangles) that may share one bounding box
+/// exactly. The BVH builder (obvhs's PLOC) pairs neighbours by the area of their union; in
+/// a run of equal boxes every pair ties, one pair merges per pass, and the build's time
+/// grows as the square of the run (40,000 copies of one triangle took 58 s, 10,000 took
+/// 3.6 s). A scene shares a box between a few primitives at most (a face and its reversed
+/// twin); copies beyond that render as one of them anyway.
+pub const MAX_SHARED_BOX: u32 = 256;
+
+/// How many primitives hold each bounding box so far ([`MAX_SHARED_BOX`]).
+#[derive(Default)]
+struct SharedBoxes(std::collections::HashMap<[u32; 6], u32>);
+
+impl SharedBoxes {
+    /// Counts the boxes of `prims[from..]` over the shutter; `Err` at `ordinal` when one is
+    /// held by more than [`MAX_SHARED_BOX`] primitives.
+    fn add(
+        &mut self,
+        prims: &[Prim],
+        from: usize,
+        (t0, t1): (f64, f64),
+        ordinal: u32,
+    ) -> Result<(), Failure> {
+        for p in &prims[from..] {
+            let n = self.0.entry(p.box_key(t0, t1)).or_insert(0);
+            *n += 1;
+            if *n > MAX_SHARED_BOX {
+                return Err((
+                    ordinal,
+                    format!(
+                        "more than {MAX_SHARED_BOX} shapes, lights or triangles lie exactly on one another here (copies of one shape in one place): only one of them can be seen; remove the copies"
+                    ),
+                ));
+            }
+        }
+        Ok(())
+    }
+}
+
 /// The shapes, added to `prims`; whether any of them moves. Each must stay within
-/// [`MAX_COORD`] over the shutter `(t0, t1)`.
+/// [`MAX_COORD`] over the shutter `(t0, t1)`, and no box may be shared by more than
+/// [`MAX_SHARED_BOX`] primitives (`boxes`, the lights' counted).
 fn shapes(
     desc: &SceneFile,
     names: &Names<'_>,
     dir: &Path,
     prims: &mut Vec<Prim>,
     (t0, t1): (f64, f64),
+    boxes: &mut SharedBoxes,
 ) -> Result<bool, Failure> {
     let mut triangles = 0usize;
     let mut any_velocity = false;
@@ -1125,6 +1170,7 @@ fn shapes(
             ShapeDesc::Sphere { material, .. } | ShapeDesc::Quad { material, .. } => material.ordinal,
         };
         within_reach(prims, from, t0, t1, ordinal)?;
+        boxes.add(prims, from, (t0, t1), ordinal)?;
     }
     Ok(any_velocity)
 }

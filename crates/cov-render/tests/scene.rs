@@ -569,3 +569,23 @@ fn a_mesh_placed_twice_is_read_once_and_placed_twice() {
     assert_eq!(three.geometry.len() - none.geometry.len(), 3 * mesh);
     assert_eq!(three.inputs.len(), 1);
 }
+
+/// Copies of one shape in one place are refused at the first past the limit, before the
+/// BVH builder, whose time grows as the square of their number; a few copies load.
+#[test]
+fn copies_of_one_shape_in_one_place_are_refused() {
+    let copies =
+        |n: usize| vec![r#"Sphere(center: (0.0, 0.5, 0.0), radius: 0.5, material: "w")"#; n].join(", ");
+    // With the base scene's own sphere, 256 copies make 257 on one box.
+    let e = error(&scene(&[("SHAPE", &copies(256))]));
+    // The material of the 257th sphere on the line: the base's at column 69, then one
+    // every 61 characters.
+    let col = 69 + 61 * 256;
+    assert!(
+        e.starts_with(&format!(
+            "5:{col}: more than 256 shapes, lights or triangles lie exactly on one another"
+        )),
+        "{e}"
+    );
+    assert!(World::from_text(&scene(&[("SHAPE", &copies(255))]), "s.ron", Path::new(".")).is_ok());
+}
