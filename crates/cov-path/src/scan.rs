@@ -321,9 +321,8 @@ pub(crate) fn operator_elements(text: &str) -> Vec<Element> {
                 expect_element = list;
             }
             ')' | '}' | ']' => {
-                if stack.pop() == Some(true) {
-                    lists -= 1;
-                }
+                let closes_list = stack.pop() == Some(true);
+                lists -= usize::from(closes_list);
             }
             ',' if in_list => expect_element = true,
             _ => {}

@@ -480,7 +480,7 @@ type Failure = (u32, String);
 fn camera(c: &CameraDesc) -> Result<Camera, Failure> {
     let position = v(c.position);
     let aim = v(c.look_at.value);
-    if !(aim.abs().max_element() <= MAX_COORD) {
+    if !aim.is_finite() || aim.abs().max_element() > MAX_COORD {
         return Err((
             c.look_at.ordinal,
             format!(
