@@ -239,6 +239,45 @@ impl PartKey {
         Ok((method, denoise))
     }
 
+    /// The settings the key records, each in its range ([`RenderSettings::check`]) and the
+    /// frame at most [`crate::world::MAX_FRAME`]: a part file is user input, and a header
+    /// edited by hand must not reach the image or the report (`spp: 1e308`).
+    ///
+    /// # Errors
+    /// The first value out of range, as a message.
+    fn check(&self) -> Result<(), String> {
+        let (method, denoise) = self.method_and_denoiser()?;
+        let max_luminance = if self.max_luminance == "inf" {
+            f64::INFINITY
+        } else {
+            self.max_luminance
+                .parse()
+                .map_err(|_| format!("a luminance clamp `{}`", crate::echo(&self.max_luminance)))?
+        };
+        RenderSettings {
+            method,
+            spp: self.spp,
+            seed: self.seed,
+            time: None,
+            cov_paths: self.cov_paths,
+            cov_stride: self.cov_stride,
+            cov_depth: self.cov_depth,
+            max_luminance,
+            denoise,
+            parts: self.parts,
+        }
+        .check()
+        .map_err(|e| e.to_string())?;
+        if self.frame > crate::world::MAX_FRAME {
+            return Err(format!(
+                "frame {}; at most {}",
+                self.frame,
+                crate::world::MAX_FRAME
+            ));
+        }
+        Ok(())
+    }
+
     /// The first field in which `self` and `other` differ, with both values.
     fn difference(&self, other: &PartKey) -> Option<String> {
         let (a, b) = (
@@ -537,8 +576,16 @@ impl PartFilm {
                 key.format
             )));
         }
+        key.check().map_err(|e| bad(format!("a damaged part key: {e}")))?;
         let info: PartInfo =
             serde_json::from_str(&info).map_err(|e| bad(format!("a damaged part header: {e}")))?;
+        // Seconds, each 0 to 1e9 (30 years), so that their sum in the report is finite.
+        if !info.timing.iter().all(|t| (0.0..=1e9).contains(t)) {
+            return Err(bad(format!(
+                "a damaged part header: timing {:?} (seconds, each 0 to 1e9)",
+                info.timing.map(cov_core::num)
+            )));
+        }
         let max = crate::scene::MAX_RESOLUTION;
         if !(1..=max).contains(&key.width) || !(1..=max).contains(&key.height) {
             return Err(bad(format!(

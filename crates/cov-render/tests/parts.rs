@@ -215,6 +215,28 @@ fn bad_parts_are_refused_with_one_line() {
     odd.write(&damaged).unwrap();
     let m = line(PartFilm::read(&damaged).unwrap_err());
     assert!(m.contains("a damaged part header: layout 9"), "{m}");
+    // A key or a timing edited by hand: refused before they reach the image or the report.
+    let mut huge = ps[0].clone();
+    huge.key.spp = 1e308;
+    let mut deep = ps[0].clone();
+    deep.key.cov_depth = 9;
+    let mut late = ps[0].clone();
+    late.key.frame = u32::MAX;
+    let mut slow = ps[0].clone();
+    slow.timing.sampling = 1e308;
+    for (p, want) in [
+        (
+            huge,
+            "a damaged part key: spp must be 1 to 65536 samples per pixel",
+        ),
+        (deep, "a damaged part key: cov_depth must be 1 to 2"),
+        (late, "a damaged part key: frame 4294967295; at most 1000000"),
+        (slow, "a damaged part header: timing"),
+    ] {
+        p.write(&damaged).unwrap();
+        let m = line(PartFilm::read(&damaged).unwrap_err());
+        assert!(m.contains(want), "{m}");
+    }
     let _ = std::fs::remove_file(&damaged);
     assert_eq!(refused, flips.len(), "every damaged file is refused");
     assert!(by_digest > 0, "some damage decodes, and the digest refuses it");
