@@ -151,12 +151,25 @@ fn whole_number_words(line: &str) -> String {
             "cannot parse integer from empty string",
             "expected a whole number",
         )
-        .replace("number too large to fit in target type", "too large");
+        .replace("number too large to fit in target type", "too large")
+        .replace("cannot parse float from empty string", "expected a number")
+        .replace("invalid float literal", "expected a number");
     match line.split_once(": -") {
         Some((head, tail)) if tail.contains(" is not in 0..=") => {
             format!("{head}: expected a whole number ≥ 0")
         }
-        _ => line,
+        // Past the type's range (`4294967296 is not in 0..=4294967295`): the option's own
+        // range is narrower, and --help gives it.
+        _ => match line.rsplit_once(": ") {
+            Some((head, tail))
+                if [u32::MAX.to_string(), u64::MAX.to_string()]
+                    .iter()
+                    .any(|max| tail.ends_with(&format!(" is not in 0..={max}"))) =>
+            {
+                format!("{head}: too large")
+            }
+            _ => line,
+        },
     }
 }
 

@@ -263,7 +263,12 @@ pub fn check_output(out: &Path, ext: &str) -> Result<(), String> {
         _ => PathBuf::from("."),
     };
     if !dir.is_dir() {
-        return Err(format!("{}: no such folder", shown(&dir)));
+        let what = if dir.exists() {
+            "not a folder"
+        } else {
+            "no such folder"
+        };
+        return Err(format!("{}: {what}", shown(&dir)));
     }
     let probe = dir.join(format!(".covtrace-write-test-{}", std::process::id()));
     std::fs::write(&probe, b"").map_err(|e| format!("{}: cannot write here: {e}", shown(&dir)))?;
@@ -297,7 +302,7 @@ pub fn not_an_input(outputs: &[PathBuf], inputs: &[PathBuf], option: &str) -> Re
     for o in outputs {
         if let Some(i) = inputs.iter().find(|i| same_file(o, i)) {
             return Err(format!(
-                "{}: an input of this run, which {option} {} would overwrite; give {option} another name",
+                "{}: an input of this run, which the outputs of {option} would overwrite (as {}); give {option} another name",
                 shown(i),
                 shown(o)
             ));

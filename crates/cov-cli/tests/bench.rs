@@ -63,7 +63,9 @@ fn a_tiny_bench_writes_every_output_and_caches_its_reference() {
 
 #[test]
 fn bad_arguments_give_one_line() {
-    let cases: [(&[&str], &str); 7] = [
+    let cases: [(&[&str], &str); 9] = [
+        (&["--budgets", ""], "'--budgets <BUDGETS>': expected a number"),
+        (&["--ref-spp", "4294967296"], "'--ref-spp <REF_SPP>': too large"),
         (
             &["--budgets", "0"],
             "--budgets: each must be a whole number of samples per pixel, 1 to 65536",
