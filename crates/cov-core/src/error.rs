@@ -103,10 +103,23 @@ pub enum CovError {
     },
 }
 
-/// A step's error without the operator's name when it begins with it (the step already
-/// names the operator: `step 1 (Integrate): …`, not `step 1 (Integrate): Integrate: …`).
+/// A step's error in the path author's words: without the operator's name when it begins
+/// with it (the step already names the operator: `step 1 (Integrate): …`, not `step 1
+/// (Integrate): Integrate: …`), and a non-finite value met inside one of core's kernels
+/// (`add_window`, `scale`: names the author never wrote) said as the overflow it is.
 fn own_words(operator: &str, source: &CovError) -> String {
     let s = source.to_string();
+    if let CovError::NonFinite { operator: kernel, .. } | CovError::Overflow { operator: kernel, .. } = source
+        && kernel != operator
+        && kernel.chars().all(|c| c.is_ascii_lowercase() || c == '_')
+    {
+        return format!(
+            "Σ overflows f64 here: the parameters, or Σ arriving here, are beyond what f64 carries (in `{kernel}`: {})",
+            s.strip_prefix(kernel.as_str())
+                .and_then(|r| r.strip_prefix(": "))
+                .unwrap_or(&s)
+        );
+    }
     match s.strip_prefix(operator).and_then(|r| r.strip_prefix(": ")) {
         Some(rest) => rest.to_string(),
         None => s,

@@ -11,7 +11,9 @@
 //!
 //! Total internal reflection transmits nothing: [`Refract::new`] returns
 //! [`CovError::NoTransport`], never NaN. Near the critical angle `cos_t → 0` and the
-//! angular scale `a` grows without bound; it stays finite while `cos_t > 0`.
+//! angular scale `a` grows without bound; it stays finite while `cos_t > 0`. The indices may
+//! be in any unit, but their ratio `n1/n2` must be 1e-6 to 1e6: beyond, `a` overflows or
+//! vanishes.
 //!
 //! Parameters, as written in a path file (`covtrace list` prints the same):
 //!
@@ -92,6 +94,12 @@ impl Refract {
     /// is left to report.
     fn snell(n1: f64, n2: f64, cos_i: f64) -> Result<Self, CovError> {
         let eta = n1 / n2;
+        // Indices in any unit, but a ratio an interface can have: past 1e6 the angular
+        // scale `a` (and Σ's) overflows or vanishes for grazing rays.
+        if !(1e-6..=1e6).contains(&eta) {
+            return Err(spec::RefractSpec::N2
+                .error(n2, format!("n1/n2 = {} must be 1e-6 to 1e6", cov_core::num(eta))));
+        }
         // sin²θ_i = (1 − cos)(1 + cos): no cancellation near normal incidence.
         let sin2_i = (1.0 - cos_i) * (1.0 + cos_i);
         let cos2_t = 1.0 - eta * eta * sin2_i;
@@ -99,8 +107,10 @@ impl Refract {
             return Err(CovError::NoTransport {
                 operator: Self::NAME.into(),
                 reason: format!(
-                    "total internal reflection: n1/n2 = {eta} and cos_i = {cos_i} give sin θ_t = {} ≥ 1",
-                    eta * sin2_i.sqrt()
+                    "total internal reflection: n1/n2 = {} and cos_i = {} give sin θ_t = {} ≥ 1",
+                    cov_core::num(eta),
+                    cov_core::num(cos_i),
+                    cov_core::num(eta * sin2_i.sqrt())
                 ),
             });
         }
