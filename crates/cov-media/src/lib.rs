@@ -216,8 +216,8 @@ pub enum Phase {
         /// Asymmetry.
         g: f64,
     },
-    /// Tabulated: `values[k]` at `angles[k]` (rad, increasing, covering the angles used);
-    /// linear interpolation, values > 0.
+    /// Tabulated: `values[k]` at `angles[k]` (rad, 0 to π, increasing, covering the angles
+    /// used); linear interpolation, values > 0.
     Tabulated {
         /// Angles (rad).
         angles: Vec<f64>,
@@ -239,7 +239,7 @@ impl Phase {
     ///
     /// # Errors
     /// `g` outside (−1, 1); a table that is empty, of mismatched lengths, not increasing,
-    /// or with non-positive or non-finite values.
+    /// with an angle outside 0 to π, or with non-positive or non-finite values.
     pub fn validated(self) -> Result<Phase, CovError> {
         match &self {
             &Phase::HenyeyGreenstein { g } => {
@@ -255,7 +255,12 @@ impl Phase {
                     });
                 }
                 for k in 0..angles.len() {
-                    arg!("Tabulated", angles[k]).finite()?;
+                    // A scattering angle: 0 (forward) to π (back), π as written with three
+                    // decimals or more (3.1416) included.
+                    arg!("Tabulated", angles[k]).require(
+                        |a| (0.0..=PI + 1e-3).contains(&a),
+                        || "must be 0 to π (rad)".into(),
+                    )?;
                     arg!("Tabulated", values[k]).positive()?;
                     if k > 0 && angles[k] <= angles[k - 1] {
                         return Err(arg!("Tabulated", angles[k]).error("strictly increasing angles"));
