@@ -1,7 +1,8 @@
 //! `covtrace plot`: one panel per step with the 1-σ ellipse of the spectrum in each
 //! (position, direction) plane, drawn with plotters and an embedded font (DejaVu Sans, the
 //! `dejavu` crate), so the picture carries its own title, step names, axes with units, tick
-//! labels and legend. All panels share one scale per plane, so sizes compare across steps.
+//! labels and legend. All panels share one scale per plane, so sizes compare across steps,
+//! except a panel of another order (a `Sensor`'s image-space Σ), which is titled "own scale".
 //!
 //! Planes are told apart by colour and by line style (they stay distinct in greyscale):
 //! `(Ωx, Ωu)` solid dark red, `(Ωy, Ωv)` dashed blue, `(Ωx, Ωt)` dotted green on the
@@ -183,6 +184,10 @@ fn tick(v: &f64, range: f64) -> String {
 }
 
 /// Which steps get a panel: all, or an even subsample of at most [`MAX_PANELS`].
+/// A panel whose peak bandwidth exceeds this many times the panels' median takes a scale
+/// of its own ([`plot`]).
+const OUTLIER: f64 = 20.0;
+
 fn shown(count: usize) -> Vec<usize> {
     if count <= MAX_PANELS {
         return (0..count).collect();
@@ -211,20 +216,51 @@ pub fn plot(e: &Evaluation, name: &str, out: &std::path::Path) -> Result<String,
     let rows = count.div_ceil(PER_ROW);
     let (w, h) = (cols * PANEL.0, TITLE_H + rows * PANEL.1 + LEGEND_H);
     let planes = planes(e.layout);
-    // One scale per kind of axis over all steps: position, direction, time.
-    let peak = |axis: usize| -> f64 {
-        mats.iter()
-            .map(|(_, m)| m[axis][axis].max(0.0).sqrt())
-            .fold(0.0f64, f64::max)
-    };
+    // One scale per kind of axis (position, direction, time) over the panels shown, but
+    // for a panel whose Σ is of another order (a `Sensor`'s image-space Σ, in cycles per
+    // metre of sensor): past OUTLIER × the panels' median peak, it takes a scale of its
+    // own, said in its title, so that the others do not shrink to a sliver.
     let pos_axes: Vec<usize> = planes.iter().map(|p| p.axes.0).collect();
     let dir_axes: Vec<usize> = planes.iter().filter(|p| !p.time).map(|p| p.axes.1).collect();
-    let scale = |axes: &[usize]| -> f64 {
-        let s = axes.iter().map(|&a| peak(a)).fold(0.0f64, f64::max) * 1.15;
+    let time_axis: Vec<usize> = planes.iter().filter(|p| p.time).map(|p| p.axes.1).collect();
+    let peak = |m: &[Vec<f64>], axes: &[usize]| -> f64 {
+        axes.iter()
+            .map(|&a| m[a][a].max(0.0).sqrt())
+            .filter(|v| v.is_finite())
+            .fold(0.0f64, f64::max)
+    };
+    let kinds = [&pos_axes, &dir_axes, &time_axis];
+    let peaks: Vec<[f64; 3]> = idx
+        .iter()
+        .map(|&k| kinds.map(|axes| peak(&mats[k].1, axes)))
+        .collect();
+    let median = |kind: usize| -> f64 {
+        let mut v: Vec<f64> = peaks.iter().map(|p| p[kind]).filter(|v| *v > 0.0).collect();
+        v.sort_by(f64::total_cmp);
+        v.get(v.len() / 2).copied().unwrap_or(0.0)
+    };
+    let medians = [median(0), median(1), median(2)];
+    let own: Vec<bool> = peaks
+        .iter()
+        .map(|p| (0..3).any(|k| medians[k] > 0.0 && p[k] > OUTLIER * medians[k]))
+        .collect();
+    let fit = |v: f64| {
+        let s = v * 1.15;
         if s.is_finite() && s > 0.0 { s } else { 1.0 }
     };
-    let (sx, sy) = (scale(&pos_axes), scale(&dir_axes));
-    let st = planes.iter().find(|p| p.time).map(|p| scale(&[p.axes.1]));
+    let shared: [f64; 3] = std::array::from_fn(|k| {
+        fit(peaks
+            .iter()
+            .zip(&own)
+            .filter(|(_, o)| !**o)
+            .map(|(p, _)| p[k])
+            .fold(0.0f64, f64::max))
+    });
+    let has_time = !time_axis.is_empty();
+    let scale_of = |i: usize| -> (f64, f64, Option<f64>) {
+        let s = if own[i] { peaks[i].map(fit) } else { shared };
+        (s[0], s[1], has_time.then_some(s[2]))
+    };
     let mut buf = vec![0u8; (w * h * 3) as usize];
     {
         let root = BitMapBackend::with_buffer(&mut buf, (w, h)).into_drawing_area();
@@ -242,11 +278,17 @@ pub fn plot(e: &Evaluation, name: &str, out: &std::path::Path) -> Result<String,
         ))
         .map_err(|e| e.to_string())?;
         let panels = body.split_evenly((rows as usize, PER_ROW.min(count) as usize));
-        for (area, &k) in panels.iter().zip(&idx) {
+        for (i, (area, &k)) in panels.iter().zip(&idx).enumerate() {
             let (title, m) = &mats[k];
-            draw_panel(area, title, m, &planes, (sx, sy, st)).map_err(|e| e.to_string())?;
+            let title = if own[i] {
+                format!("{title} (own scale)")
+            } else {
+                title.clone()
+            };
+            draw_panel(area, &title, m, &planes, scale_of(i)).map_err(|e| e.to_string())?;
         }
-        draw_legend(&legend, &planes, count as usize, mats.len()).map_err(|e| e.to_string())?;
+        draw_legend(&legend, &planes, count as usize, mats.len(), own.contains(&true))
+            .map_err(|e| e.to_string())?;
         root.present().map_err(|e| e.to_string())?;
     }
     let img = image::RgbImage::from_raw(w, h, buf).ok_or("image buffer size")?;
@@ -301,6 +343,17 @@ fn draw_panel(
             .axis_desc_style(("sans-serif", 11))
             .draw()?;
     }
+    // A Σ of zeros draws nothing: say so rather than leave the panel looking broken.
+    if planes
+        .iter()
+        .all(|p| m[p.axes.0][p.axes.0] == 0.0 && m[p.axes.1][p.axes.1] == 0.0)
+    {
+        chart.draw_series(std::iter::once(Text::new(
+            "Σ = 0: constant on every axis",
+            (-0.6 * sx, 0.0),
+            ("sans-serif", 12).into_font().color(&RGBColor(90, 90, 90)),
+        )))?;
+    }
     for p in planes {
         let (a, b) = p.axes;
         let pts = ellipse([m[a][a], m[a][b], m[b][b]]);
@@ -326,6 +379,7 @@ fn draw_legend(
     planes: &[Plane],
     shown: usize,
     total: usize,
+    any_own: bool,
 ) -> DrawResult {
     let font = ("sans-serif", 14).into_font().color(&BLACK);
     let mut x = 12;
@@ -347,10 +401,15 @@ fn draw_legend(
         area.draw(&Text::new(p.name, (x1 + 8, 10), font.clone()))?;
         x += 250;
     }
-    let note = if shown < total {
-        format!("1σ contours; one scale for all panels; {shown} of {total} steps shown")
+    let scales = if any_own {
+        "one scale for all panels but those of their own"
     } else {
-        "1σ contours; one scale for all panels".into()
+        "one scale for all panels"
+    };
+    let note = if shown < total {
+        format!("1σ contours; {scales}; {shown} of {total} steps shown")
+    } else {
+        format!("1σ contours; {scales}")
     };
     area.draw(&Text::new(
         note,
