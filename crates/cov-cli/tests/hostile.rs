@@ -125,25 +125,36 @@ fn refocusing_chains_stay_psd_in_both_forms() {
     }
 }
 
-/// The worst inputs within the documented bounds run in bounded memory: a path file just
-/// under the 16 MiB cap (one operator list of 400,000 steps), evaluated and plotted, under a
-/// 2 GiB address-space limit (`ulimit -v`), and within a minute each.
+/// The worst inputs within the documented bounds run in bounded memory: a path of the most
+/// operators a path may hold (100,000), evaluated (as text and as JSON) and plotted, under
+/// a 2 GiB address-space limit (`ulimit -v`), and within a minute each; a path file just
+/// under the 16 MiB cap (400,000 steps) is refused for its length, in the same bounds.
 #[test]
 fn the_largest_inputs_run_in_bounded_memory() {
+    let path = |n: usize| {
+        let ops = vec!["Travel(distance: 1.0)"; n].join(",");
+        format!("Path(source: Gaussian(x: 0.1), operators: [{ops}])")
+    };
     let ron = common::tmp("hostile", "huge.ron");
-    let ops = vec!["Travel(distance: 1.0)"; 400_000].join(",");
-    let text = format!("Path(source: Gaussian(x: 0.1), operators: [{ops}])");
+    std::fs::write(&ron, path(100_000)).expect("write");
+    let over = common::tmp("hostile", "over.ron");
+    let text = path(400_000);
     assert!(text.len() < 16 << 20);
-    std::fs::write(&ron, text).expect("write");
+    std::fs::write(&over, text).expect("write");
     let png = common::tmp("hostile", "huge.png");
     let bin = env!("CARGO_BIN_EXE_covtrace");
     let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
     for cmd in [
         format!("'{bin}' eval '{}' > /dev/null", ron.display()),
+        format!("'{bin}' eval --json '{}' > /dev/null", ron.display()),
         format!(
             "'{bin}' plot '{}' -o '{}' > /dev/null",
             ron.display(),
             png.display()
+        ),
+        format!(
+            "'{bin}' eval '{}' 2>&1 | grep -q 'the path holds 400000 operators; at most 100000'",
+            over.display()
         ),
     ] {
         let t = std::time::Instant::now();
