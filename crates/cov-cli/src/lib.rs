@@ -129,6 +129,14 @@ pub fn format_decisions(d: &covtrace::sensor::PixelDecisions) -> String {
         d.density,
         volume.join("·")
     ));
-    out.push_str(&format!("  samples per pixel   {:.3}\n", d.samples_per_pixel));
+    out.push_str(&format!(
+        "  samples per pixel   {:.3}{}\n",
+        d.samples_per_pixel,
+        if d.samples_per_pixel < 1.0 {
+            " (below one: a renderer still takes one; check that the Sensor's distance, aperture and shutter match the lens and shutter of the path)"
+        } else {
+            ""
+        }
+    ));
     out
 }
