@@ -56,6 +56,16 @@ fn explain(
     }
     let prefix: String = ops.iter().map(|op| format!("{op}: ")).collect();
     let rest = rest.to_string();
+    // `0x10` where a decimal number belongs: ron reads the `0` and stops at the `x`.
+    if let Some((name, (l, c), value)) = crate::scan::field_at(text, line, col)
+        && let Some(words) = not_decimal(&value)
+    {
+        return (
+            l,
+            c,
+            format!("{prefix}parameter `{name}` = {}: {words}", cov_core::echo(&value)),
+        );
+    }
     if let Some(found) = wrong_type(
         text,
         (line, col),
@@ -143,6 +153,24 @@ fn wrong_type(
         (w, None) => format!("parameter `{name}` = {value}: expected {w}"),
     };
     Some((l, c, format!("{prefix}{message}")))
+}
+
+/// What is wrong with a number written in another base (`0x10`, `0b1`, `0o7`, signed or
+/// not) where covtrace reads decimals: ron reads the leading `0` of it as a decimal number
+/// and stops at the letter. `None` for anything else.
+pub fn not_decimal(written: &str) -> Option<&'static str> {
+    let digits = written.trim_start_matches(['-', '+']);
+    let base = match digits.get(..2)? {
+        "0x" | "0X" => "hexadecimal",
+        "0b" | "0B" => "binary",
+        "0o" | "0O" => "octal",
+        _ => return None,
+    };
+    Some(match base {
+        "hexadecimal" => "a hexadecimal number; write it in decimal (`0x10` is 16.0)",
+        "binary" => "a binary number; write it in decimal (`0b101` is 5.0)",
+        _ => "an octal number; write it in decimal (`0o17` is 15.0)",
+    })
 }
 
 /// What ron's message that a value has the wrong type says was expected, in a file

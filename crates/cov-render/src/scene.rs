@@ -556,8 +556,13 @@ impl SceneFile {
             let (line, col) = (e.span.start.line, e.span.start.col);
             let mut message = e.code.to_string();
             let field = || cov_path::field_at(text, line, col);
-            // A value the checked types refused: name its field, as the user wrote it.
-            if let ron::Error::Message(m) = &e.code
+            // `0x1` where a decimal belongs: ron reads the `0` (so a checked type refuses 0,
+            // or ron stops at the `x`).
+            if let Some((name, _, value)) = field()
+                && let Some(words) = cov_path::not_decimal(&value)
+            {
+                message = format!("`{name}` = {}: {words}", cov_core::echo(&value));
+            } else if let ron::Error::Message(m) = &e.code
                 && let Some((name, ..)) = field()
             {
                 message = if m.starts_with("must be ") {

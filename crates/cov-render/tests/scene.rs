@@ -589,3 +589,22 @@ fn copies_of_one_shape_in_one_place_are_refused() {
     );
     assert!(World::from_text(&scene(&[("SHAPE", &copies(255))]), "s.ron", Path::new(".")).is_ok());
 }
+
+/// A number in another base where a decimal belongs says so, at its field (ron reads the
+/// leading `0` and the radius check refused 0, or ron stopped at the letter).
+#[test]
+fn a_number_in_another_base_says_so() {
+    for (shape, want) in [
+        (
+            r#"Sphere(center: (0.0, 0.5, 0.0), radius: 0x1, material: "w")"#,
+            "`radius` = 0x1: a hexadecimal number; write it in decimal",
+        ),
+        (
+            r#"Sphere(center: (0.0, 0.5, 0.0), radius: 0b1, material: "w")"#,
+            "`radius` = 0b1: a binary number",
+        ),
+    ] {
+        let e = error(&scene(&[("SHAPE", shape)]));
+        assert!(e.starts_with("5:115: ") && e.contains(want), "{e}");
+    }
+}
