@@ -114,7 +114,7 @@ fn merged_parts_are_the_single_render() {
         let err = String::from_utf8_lossy(&out.stderr);
         assert_eq!(out.status.code(), Some(2), "{err}");
         assert!(
-            err.contains("an input of this run, which -o")
+            err.contains("an input of this run, which the outputs of -o")
                 && err.contains("would overwrite")
                 && err.trim_end().lines().count() == 1,
             "{err}"
