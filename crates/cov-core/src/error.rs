@@ -152,6 +152,25 @@ pub fn num(v: f64) -> String {
     }
 }
 
+/// A value the program computed (a least size, a reach), as a message shows it: six
+/// significant digits in [`num`]'s notation, so that `4.9000000000000005e-6` reads
+/// `4.9e-6` (rounding noise gone, and a value compared with a limit still told from it
+/// unless the two agree to six digits). A value the user wrote is echoed with [`num`],
+/// exactly.
+///
+/// ```
+/// assert_eq!(cov_core::approx(4.9000000000000005e-6), "4.9e-6");
+/// assert_eq!(cov_core::approx(9.999999999999999e299), "1e300");
+/// assert_eq!(cov_core::approx(0.30000000000000004), "0.3");
+/// ```
+pub fn approx(v: f64) -> String {
+    if v == 0.0 || !v.is_finite() {
+        return format!("{v}");
+    }
+    let rounded: f64 = format!("{v:.5e}").parse().unwrap_or(v);
+    num(rounded)
+}
+
 /// Longest piece of user input echoed in a message (characters).
 pub const ECHO_MAX: usize = 64;
 

@@ -82,7 +82,7 @@ pub use any::{AnyCov, AnyFactor, AnySpectrum};
 pub use axis::{Axis, AxisSet, axis_index, layout_axes, layout_set};
 pub use cov::{Cov, DIRAC_RELATIVE_SIZE, FOUR_PI_SQ, PSD_RTOL, Validity};
 pub use cov_derive::OperatorSpec;
-pub use error::{CovError, ECHO_MAX, echo, line_col, num, one_line, utf8_error_at};
+pub use error::{CovError, ECHO_MAX, approx, echo, line_col, num, one_line, utf8_error_at};
 pub use form::{CovFactor, ROW_SNAP, SCHUR_SNAP};
 pub use operator::{Chain, Operator, Step, Trace};
 pub use query::{CovBlock, Filter, NYQUIST_K};

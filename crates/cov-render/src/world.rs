@@ -9,8 +9,8 @@ use glam::{DVec2, DVec3};
 use crate::geometry::{Geometry, Hit, MAX_COORD, Prim, Shape};
 use crate::material::{Material, basis};
 use crate::scene::{
-    At, CameraDesc, LightDesc, MAX_SCENE_BYTES, MAX_TRIANGLES, MaterialDesc, Rgb, SceneError, SceneFile,
-    ShapeDesc, TextureDesc, V3,
+    At, CameraDesc, LightDesc, MAX_SCENE_BYTES, MAX_SHARED_BOX, MAX_TRIANGLES, MaterialDesc, Rgb, SceneError,
+    SceneFile, ShapeDesc, TextureDesc, V3,
 };
 use crate::texture::TextureMap;
 
@@ -367,7 +367,8 @@ impl World {
         let reach = self.geometry.reach(t0, t1).max(self.camera.reach(t0, t1));
         (reach > MAX_COORD).then(|| {
             format!(
-                "a frame at which every shape and the camera stay within ±{MAX_COORD:e} m (this one moves one to {reach:e} m)"
+                "a frame at which every shape and the camera stay within ±{MAX_COORD:e} m (this one moves one to {} m)",
+                cov_core::approx(reach)
             )
         })
     }
@@ -583,7 +584,8 @@ fn camera(c: &CameraDesc) -> Result<Camera, Failure> {
                 s.close.ordinal,
                 format!(
                     "the shutter closes ({}) before it opens ({})",
-                    s.close.value.0, s.open.0
+                    cov_core::num(s.close.value.0),
+                    cov_core::num(s.open.0)
                 ),
             ));
         }
@@ -1000,7 +1002,7 @@ fn large_enough(desc: &SceneFile) -> Result<(), Failure> {
 fn at_least(least: f64) -> String {
     format!(
         "at least {} m here ({:e} of 1 m + its distance along an axis from the origin)",
-        cov_core::num(least),
+        cov_core::approx(least),
         crate::geometry::MIN_SIZE
     )
 }
@@ -1015,18 +1017,11 @@ fn within_reach(prims: &[Prim], from: usize, t0: f64, t1: f64, ordinal: u32) -> 
     Err((
         ordinal,
         format!(
-            "this shape reaches {reach:e} m from the origin (over the shutter, if it moves): the renderer's single-precision BVH holds ±{MAX_COORD:e} m"
+            "this shape reaches {} m from the origin (over the shutter, if it moves): the renderer's single-precision BVH holds ±{MAX_COORD:e} m",
+            cov_core::approx(reach)
         ),
     ))
 }
-
-/// Most primitives (shapes, lights, a mesh's triangles) that may share one bounding box
-/// exactly. The BVH builder (obvhs's PLOC) pairs neighbours by the area of their union; in
-/// a run of equal boxes every pair ties, one pair merges per pass, and the build's time
-/// grows as the square of the run (40,000 copies of one triangle took 58 s, 10,000 took
-/// 3.6 s). A scene shares a box between a few primitives at most (a face and its reversed
-/// twin); copies beyond that render as one of them anyway.
-pub const MAX_SHARED_BOX: u32 = 256;
 
 /// How many primitives hold each bounding box so far ([`MAX_SHARED_BOX`]).
 #[derive(Default)]
@@ -1155,7 +1150,7 @@ fn shapes(
                         obj.ordinal,
                         format!(
                             "this mesh is {} m across after its `scale`; {}",
-                            cov_core::num(size),
+                            cov_core::approx(size),
                             at_least(least)
                         ),
                     ));

@@ -230,16 +230,13 @@ fn what_single_precision_cannot_hold_is_refused() {
         r#"Sphere(center: (2e12, 0.5, 0.0), radius: 0.5, material: "w")"#,
     )]);
     let e = error(&far);
-    assert!(
-        e.starts_with("5:131: this shape reaches 2.0000000000005e12 m"),
-        "{e}"
-    );
+    assert!(e.starts_with("5:131: this shape reaches 2e12 m"), "{e}");
     let light = scene(&[(
         "LIGHTS",
         "[Sphere(center: (0.0, 2.0, -5e12), radius: 0.2, radiance: (1.0, 1.0, 1.0))]",
     )]);
     assert!(
-        error(&light).starts_with("4:13: this shape reaches 5.0000000000002e12 m"),
+        error(&light).starts_with("4:13: this shape reaches 5e12 m"),
         "{}",
         error(&light)
     );
