@@ -56,6 +56,9 @@ fn explain(
     }
     let prefix: String = ops.iter().map(|op| format!("{op}: ")).collect();
     let rest = rest.to_string();
+    if let Some(((l, c), words)) = crate::scan::odd_space_before(text, line, col) {
+        return (l, c, words);
+    }
     // `0x10` where a decimal number belongs: ron reads the `0` and stops at the `x`.
     if let Some((name, (l, c), value)) = crate::scan::field_at(text, line, col)
         && let Some(words) = not_decimal(&value)

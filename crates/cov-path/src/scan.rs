@@ -258,6 +258,33 @@ pub fn field_at(text: &str, line: usize, col: usize) -> Option<(String, (usize, 
     Some((name, pos[start], value))
 }
 
+/// The first whitespace character other than an ASCII space, tab or line break (a
+/// no-break space U+00A0, an em space, an ideographic space…) outside comments and strings,
+/// before `(line, col)` or in the whitespace just after it: RON does not read it as space, and reports whatever it
+/// stopped at instead (a number "expected", a comma). Its position and a message naming it.
+pub fn odd_space_before(text: &str, line: usize, col: usize) -> Option<((usize, usize), String)> {
+    let text = text.strip_prefix('\u{feff}').unwrap_or(text);
+    let chars = code_of(&text.chars().collect::<Vec<char>>());
+    let pos = char_positions(&chars);
+    // Up to the error and the run of whitespace that follows it (ron may stop just before
+    // the odd character).
+    let mut end = pos.iter().position(|&p| p > (line, col)).unwrap_or(chars.len());
+    while end < chars.len() && chars[end].is_whitespace() {
+        end += 1;
+    }
+    let (i, c) = chars[..end]
+        .iter()
+        .enumerate()
+        .find(|(_, c)| c.is_whitespace() && !matches!(c, ' ' | '\t' | '\n' | '\r'))?;
+    Some((
+        pos[i],
+        format!(
+            "a U+{:04X} space character here: a file reads only plain spaces, tabs and line breaks between values (it often comes from pasting text)",
+            u32::from(*c)
+        ),
+    ))
+}
+
 /// Every element of every operator list, in the order of the text.
 pub(crate) fn operator_elements(text: &str) -> Vec<Element> {
     let chars: Vec<char> = text.chars().collect();

@@ -561,6 +561,13 @@ impl SceneFile {
     pub fn parse(text: &str, file: &str) -> Result<SceneFile, SceneError> {
         Self::parse_probed(text, None).map_err(|e| {
             let (line, col) = (e.span.start.line, e.span.start.col);
+            if let Some(((line, col), message)) = cov_path::odd_space_before(text, line, col) {
+                return SceneError {
+                    file: file.to_string(),
+                    at: Some((line, col)),
+                    message,
+                };
+            }
             let mut message = e.code.to_string();
             let field = || cov_path::field_at(text, line, col);
             // `0x1` where a decimal belongs: ron reads the `0` (so a checked type refuses 0,

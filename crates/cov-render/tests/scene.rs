@@ -605,3 +605,14 @@ fn a_number_in_another_base_says_so() {
         assert!(e.starts_with("5:115: ") && e.contains(want), "{e}");
     }
 }
+
+/// A space character other than a plain space, tab or line break (a no-break space pasted
+/// in) is named where it stands, not blamed on the value after it; in a comment it is
+/// harmless.
+#[test]
+fn an_unusual_space_is_named_where_it_stands() {
+    let e = error(&scene(&[("FOV", "\u{a0}40.0")]));
+    assert!(e.starts_with("2:72: a U+00A0 space character here"), "{e}");
+    let commented = scene(&[("FOV", "40.0 /* a\u{a0}b */")]);
+    assert!(World::from_text(&commented, "s.ron", Path::new(".")).is_ok());
+}
