@@ -34,7 +34,7 @@
 //! |  | `filter` | px | `0.5` | > 0 | Pixel filter std. |
 //! |  | `aperture` | m | optional | in (0, 1e6] | Aperture std, when the lens is sampled. |
 //! |  | `shutter` | s | optional | in (0, 1e6] | Shutter std, when time is sampled (needs axis `t`). |
-//! |  | `nyquist` | – | `NYQUIST_K` | in (0, 1e3] | Nyquist factor k. |
+//! |  | `nyquist` | – | `2.0` | in (0, 1e3] | Nyquist factor k (core's `NYQUIST_K`). |
 //! |  | `max_filter` | px | `8.0` | in (0, 1e6] | Largest filter std. (The upper bounds here are far beyond any use, so that no decision overflows f64: a squared `max_filter` of 1e155 px would.) |
 //! | `Integrate` | `axes` | – | required | – | Axes to integrate over: a list of `x`, `y`, `u`, `v`, `t`. |
 //! <!-- end of parameters -->
@@ -116,8 +116,8 @@ pub struct SensorParams {
     /// Shutter std, when time is sampled (needs axis `t`).
     #[param(unit = "s", default, gt = 0, le = 1e6)]
     pub shutter: Option<f64>,
-    /// Nyquist factor k.
-    #[param(default = NYQUIST_K, gt = 0, le = 1e3)]
+    /// Nyquist factor k (core's `NYQUIST_K`).
+    #[param(default = 2.0, gt = 0, le = 1e3)]
     pub nyquist: f64,
     /// Largest filter std. (The upper bounds here are far beyond any use, so that no
     /// decision overflows f64: a squared `max_filter` of 1e155 px would.)

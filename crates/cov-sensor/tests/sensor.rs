@@ -121,3 +121,11 @@ fn bad_parameters_and_integrate() {
     Operator::apply(&Integrate::new(vec![Axis::T]).unwrap(), &mut c).unwrap();
     assert_eq!(c.get(2, 2), 0.0);
 }
+
+/// The Nyquist factor's default, written out in the parameter table, is core's `NYQUIST_K`.
+#[test]
+fn the_nyquist_default_is_cores() {
+    assert_eq!(cov_sensor::SensorParams::NYQUIST.default, Some("2.0"));
+    assert_eq!(cov_core::NYQUIST_K, 2.0);
+    assert_eq!(SensorParams::default().nyquist, cov_core::NYQUIST_K);
+}
