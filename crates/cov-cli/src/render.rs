@@ -55,7 +55,7 @@ pub struct RenderArgs {
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
     /// Render at this size instead of the scene's (`WIDTHxHEIGHT`, e.g. `640x480`).
-    #[arg(long, value_parser = parse_size)]
+    #[arg(long, value_parser = parse_size, allow_hyphen_values = true)]
     pub size: Option<(u32, u32)>,
     /// Render only part I of N (`I/N`, e.g. `2/4`) and write it as a part file (EXR) for
     /// `covtrace merge`: a job array renders the parts, one merge makes the image, which is
@@ -717,7 +717,7 @@ pub struct CheckArgs {
     #[arg(long, default_value_t = cov_render::DEFAULT_DEPTH, value_parser = clap::value_parser!(u32).range(1..=i64::from(cov_render::covpass::MAX_DEPTH)))]
     pub cov_depth: u32,
     /// Render at this size instead of the scene's (`WIDTHxHEIGHT`).
-    #[arg(long, value_parser = parse_size)]
+    #[arg(long, value_parser = parse_size, allow_hyphen_values = true)]
     pub size: Option<(u32, u32)>,
     /// Seed.
     #[arg(long, default_value_t = 1)]

@@ -63,7 +63,11 @@ fn a_tiny_bench_writes_every_output_and_caches_its_reference() {
 
 #[test]
 fn bad_arguments_give_one_line() {
-    let cases: [(&[&str], &str); 9] = [
+    let cases: [(&[&str], &str); 10] = [
+        (
+            &["--size", "-64x48"],
+            "--size must be WIDTHxHEIGHT (or WIDTH×HEIGHT) with sides 1 to",
+        ),
         (&["--budgets", ""], "'--budgets <BUDGETS>': expected a number"),
         (&["--ref-spp", "4294967296"], "'--ref-spp <REF_SPP>': too large"),
         (
