@@ -1,6 +1,8 @@
 //! The scene as the renderer uses it: camera, lights, materials and geometry, built from a
 //! [`SceneFile`] with every cross-reference checked.
 
+use std::collections::hash_map::Entry;
+use std::collections::{HashMap, HashSet};
 use std::f64::consts::PI;
 use std::path::Path;
 
@@ -1025,7 +1027,7 @@ fn within_reach(prims: &[Prim], from: usize, t0: f64, t1: f64, ordinal: u32) -> 
 
 /// How many primitives hold each bounding box so far ([`MAX_SHARED_BOX`]).
 #[derive(Default)]
-struct SharedBoxes(std::collections::HashMap<[u32; 6], u32>);
+struct SharedBoxes(HashMap<[u32; 6], u32>);
 
 impl SharedBoxes {
     /// Counts the boxes of `prims[from..]` over the shutter; `Err` at `ordinal` when one is
@@ -1067,7 +1069,7 @@ fn shapes(
     let mut triangles = 0usize;
     let mut any_velocity = false;
     // Each OBJ file is read once, however many meshes place it.
-    let mut read: std::collections::HashMap<std::path::PathBuf, Vec<ObjTriangle>> = Default::default();
+    let mut read: HashMap<std::path::PathBuf, Vec<ObjTriangle>> = HashMap::new();
     for s in &desc.shapes {
         let from = prims.len();
         let (material, velocity) = match s {
@@ -1116,16 +1118,15 @@ fn shapes(
                 ..
             } => {
                 let in_obj = |e: String| (obj.ordinal, format!("OBJ `{}`: {e}", crate::echo(&obj.value)));
-                let path = dir.join(&obj.value);
-                if !read.contains_key(&path) {
-                    let tris = load_obj(&path, MAX_TRIANGLES - triangles).map_err(in_obj)?;
-                    read.insert(path.clone(), tris);
-                }
-                let tris = read.get(&path).map_or(&[][..], Vec::as_slice);
+                let tris = match read.entry(dir.join(&obj.value)) {
+                    Entry::Occupied(e) => e.into_mut(),
+                    Entry::Vacant(e) => {
+                        let tris = load_obj(e.key(), MAX_TRIANGLES - triangles).map_err(in_obj)?;
+                        e.insert(tris)
+                    }
+                };
                 if tris.len() > MAX_TRIANGLES - triangles {
-                    return Err(in_obj(format!(
-                        "more than {MAX_TRIANGLES} triangles in the scene; meshes are read up to that"
-                    )));
+                    return Err(in_obj(too_many_triangles()));
                 }
                 triangles += tris.len();
                 let (t, sc) = (translate.map_or(DVec3::ZERO, v), scale.map_or(1.0, |s| s.0));
@@ -1183,6 +1184,12 @@ const QUAD_UV: [[DVec2; 3]; 2] = [
 
 type ObjTriangle = ([DVec3; 3], Option<[DVec3; 3]>, Option<[DVec2; 3]>);
 
+/// The message of a scene past [`MAX_TRIANGLES`], whether one file or its placements
+/// bring it there.
+fn too_many_triangles() -> String {
+    format!("more than {MAX_TRIANGLES} triangles in the scene; meshes are read up to that")
+}
+
 /// Triangles (with vertex normals and texture coordinates when the file has them) of an
 /// OBJ file, at most `limit`.
 fn load_obj(path: &Path, limit: usize) -> Result<Vec<ObjTriangle>, String> {
@@ -1214,9 +1221,7 @@ fn load_obj(path: &Path, limit: usize) -> Result<Vec<ObjTriangle>, String> {
         };
         for f in mesh.indices.chunks_exact(3) {
             if out.len() >= limit {
-                return Err(format!(
-                    "more than {MAX_TRIANGLES} triangles in the scene; meshes are read up to that"
-                ));
+                return Err(too_many_triangles());
             }
             // The reader checked every index against the file's vertices.
             let bad = "a vertex (`v`) has a coordinate that is not a finite number";
@@ -1297,7 +1302,7 @@ pub const MAX_FRAME: u32 = 1_000_000;
 /// The files a scene reads besides itself (texture images, OBJ meshes), resolved against
 /// `dir`, each once, in the order the scene first names them.
 fn input_files(desc: &SceneFile, dir: &Path) -> Vec<std::path::PathBuf> {
-    let mut seen = std::collections::HashSet::new();
+    let mut seen = HashSet::new();
     let textures = desc.textures.values().filter_map(|t| match &t.value {
         TextureDesc::Image { file, .. } => Some(dir.join(&file.value)),
         _ => None,
