@@ -316,14 +316,7 @@ pub fn trace_path<R: Rng>(
     let side = (block[2] - block[0]).max(block[3] - block[1]).max(1.0);
     let footprint = footprints(world, hit.t, hit.n.dot(d_out), side);
     // 5–6. The camera side, the end of every vertex's chain.
-    let tail = camera_side(
-        world,
-        cc,
-        (&hit, d_out),
-        ((px, py), block),
-        (time, ut),
-        footprint.0,
-    )?;
+    let tail = camera_side(world, cc, (&hit, d_out), ((px, py), block), ut, footprint.0)?;
     let mut emit = |start: &AnyCov, chain: &Chain, weight: f64| -> Result<(), CovError> {
         let rates = cc.sensor.rates(&chain.eval_any(Form::Covariance, start)?)?;
         if weight.is_finite() && weight >= 0.0 {
@@ -515,7 +508,7 @@ fn camera_side(
     cc: &CovCamera,
     (hit, d_out): (&Hit, DVec3),
     ((px, py), block): ((f64, f64), Block),
-    (time, ut): (f64, f64),
+    ut: f64,
     footprint: f64,
 ) -> Result<Chain, CovError> {
     let cam = &world.camera;
@@ -523,7 +516,7 @@ fn camera_side(
     let x_out = frame_x(d_out, hit.n);
     let x_cam = frame_x(d_out, cam.right);
     let mut chain = Chain::new();
-    match nearest_silhouette(world, hit, (px, py), block, (time, ut), footprint) {
+    match nearest_silhouette(world, hit, (px, py), block, ut, footprint) {
         Some(e) => {
             chain.push(Travel::new((hit.t - e.depth).max(0.0))?);
             let edge = Chain::new().with(BlockerEdge::new(e.radius)?);
@@ -725,12 +718,23 @@ fn same_surface(world: &World, a: &Hit, b: &Hit) -> bool {
 /// nearer surface's depth, half a pixel's footprint from the path there: a block that holds
 /// an edge predicts it for all its pixels. Each edge's window is weighed by its
 /// [`contrast`], from the two sides' [`direct_proxy`]; the strongest window wins.
+///
+/// The probes above are taken at the path's own instant. Where motion is traced, two more
+/// rays through the path's own image point, a third and two thirds of the shutter later
+/// (modulo the shutter), look for an object that crosses the pixel while the shutter is
+/// open: a ball that rolls through a pixel of felt for part of the exposure draws its
+/// swept band's edges there, which a path that sees the felt at its instant would miss.
+/// With the path's own time they sample the shutter at three equally spaced instants, so
+/// an object that covers the pixel for more than a third of the exposure is always found;
+/// one that covers it for less adds less contrast to the time-integrated pixel. The edge
+/// found is the same space-time edge as one found at the path's instant, and takes the
+/// nearer surface's velocity (`Moving`): only its extent across the motion stays sharp.
 fn nearest_silhouette(
     world: &World,
     hit: &Hit,
     (px, py): (f64, f64),
     block: Block,
-    (time, ut): (f64, f64),
+    ut: f64,
     footprint: f64,
 ) -> Option<Silhouette> {
     let cam = &world.camera;
@@ -745,16 +749,26 @@ fn nearest_silhouette(
         (x1 - 0.5, y1 - 0.5),
     ];
     let big = x1 - x0 > 1.0 || y1 - y0 > 1.0;
+    // With motion traced, the path's own image point at the other two thirds of the
+    // shutter: with the path's own time they sample it at three equally spaced instants
+    // (see above).
+    let thirds = world.has_motion && cam.shutter.is_some();
     let probes = around
         .iter()
         .take(EDGE_PROBES)
-        .map(|&(dx, dy)| (px + dx, py + dy))
-        .chain(corners.into_iter().filter(|_| big));
-    for (qx, qy) in probes {
-        let r = cam.ray(qx, qy, (0.5, 0.5), ut);
+        .map(|&(dx, dy)| (px + dx, py + dy, ut))
+        .chain(corners.into_iter().filter(|_| big).map(|(x, y)| (x, y, ut)))
+        .chain(
+            [1.0 / 3.0, 2.0 / 3.0]
+                .into_iter()
+                .filter(|_| thirds)
+                .map(|d| (px, py, (ut + d).fract())),
+        );
+    for (qx, qy, uq) in probes {
+        let r = cam.ray(qx, qy, (0.5, 0.5), uq);
         let h = world
             .geometry
-            .intersect(r.origin, r.dir, time, 0.0, f64::INFINITY);
+            .intersect(r.origin, r.dir, r.time, 0.0, f64::INFINITY);
         // Where the probe would meet the hit's tangent plane: a surface that continues
         // smoothly is no silhouette, however oblique (at grazing angles its depth changes
         // by more than DEPTH_JUMP within half a pixel).

@@ -600,3 +600,42 @@ fn diagonal_stripes_are_oriented_as_the_image_is() {
         );
     }
 }
+
+/// A ball that rolls across a pixel while the shutter is open draws the edges of its
+/// swept band there, across its motion, even where the pixel's covariance path sees the
+/// background at its own instant. Here the ball sweeps twice its diameter along the rows,
+/// so the pixels of its middle row near the sweep's centre are covered for about half of
+/// the exposure, and most of their paths miss it. Each of them must predict the band's
+/// edge: detail across the motion (`Σ_yy`), where the background alone (lit from above,
+/// the ball's shadow far below these rows) has none. Before 2026-11-28 the pass probed
+/// for edges at the path's instant only, and these pixels read as bare background.
+#[test]
+fn a_ball_crossing_a_pixel_during_the_shutter_is_seen() {
+    let text = r#"Scene(
+        camera: (position: (0.0, 0.0, 6.0), look_at: (0.0, 0.0, 0.0), up: (0.0, 1.0, 0.0), fov: 12.0, width: 32, height: 32, shutter: (open: 0.0, close: 0.2)),
+        materials: { "c": Diffuse(albedo: (0.8, 0.8, 0.8)), "bg": Diffuse(albedo: (0.1, 0.1, 0.1)) },
+        lights: [Sphere(center: (0.0, 8.0, 6.0), radius: 0.5, radiance: (40.0, 40.0, 40.0))],
+        shapes: [Sphere(center: (-0.24, 0.0, 0.0), radius: 0.12, material: "c", velocity: (2.4, 0.0, 0.0)),
+                 Quad(corner: (-5.0, -5.0, -1.0), edge_u: (10.0, 0.0, 0.0), edge_v: (0.0, 10.0, 0.0), material: "bg")],
+    )"#;
+    let world = World::from_text(text, "<test>", std::path::Path::new(".")).unwrap();
+    let own = own_window();
+    let across = |maps: &cov_render::CovMaps, x: usize, y: usize| maps.pixels[y * 32 + x].sigma[2] - own;
+    for seed in 1..4 {
+        let maps = cov_render::covpass::covariance_rows(&world, 1, 1, 1, seed, 0..32, None).unwrap();
+        // The background far from the band: rows 2 to 5.
+        let bare = (2..6)
+            .flat_map(|y| (4..28).map(move |x| (x, y)))
+            .map(|(x, y)| across(&maps, x, y))
+            .fold(0.0, f64::max);
+        for y in 15..17 {
+            for x in 13..19 {
+                let a = across(&maps, x, y);
+                assert!(
+                    a > 0.1 * own && a > 100.0 * bare,
+                    "seed {seed}, pixel ({x}, {y}): Σ_yy beyond the pixel filter's {a}, the background's {bare}, the filter's own {own}"
+                );
+            }
+        }
+    }
+}
