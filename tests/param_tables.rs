@@ -105,3 +105,44 @@ fn no_operator_crate_spells_a_parameter_name_in_a_string() {
         found.join("\n")
     );
 }
+
+/// A default is shown as a path file writes it: an enum variant by its own name, a
+/// negative number with its sign against it (the derive's `quote` text read `Which :: B`
+/// and `- 1.5`).
+#[test]
+fn defaults_read_as_a_file_writes_them() {
+    use covtrace::{Build, Checked, CovError, Operator, OperatorSpec, Spectrum};
+
+    #[derive(Clone, Copy, Debug, Default, serde::Deserialize)]
+    enum Which {
+        #[default]
+        A,
+        B,
+    }
+    #[derive(Debug)]
+    struct Nothing;
+    impl Operator for Nothing {
+        fn apply(&self, _: &mut dyn Spectrum) -> Result<(), CovError> {
+            Ok(())
+        }
+    }
+    #[derive(Debug, OperatorSpec)]
+    #[operator(summary = "a test of defaults")]
+    struct ShowSpec {
+        /// An enum with a default variant.
+        #[param(default = Which::B)]
+        which: Which,
+        /// A negative default.
+        #[param(default = -1.5)]
+        shift: f64,
+    }
+    impl Build for ShowSpec {
+        type Op = Nothing;
+        fn make(p: Checked<Self>) -> Result<Nothing, CovError> {
+            let _ = (p.which, p.shift);
+            Ok(Nothing)
+        }
+    }
+    assert_eq!(ShowSpec::WHICH.default, Some("B"));
+    assert_eq!(ShowSpec::SHIFT.default, Some("-1.5"));
+}

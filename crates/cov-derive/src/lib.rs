@@ -337,7 +337,7 @@ fn expand(input: &DeriveInput) -> syn::Result<Tokens> {
             None => quote!(::core::option::Option::None),
             Some(None) => quote!(::core::option::Option::Some(#core::spec::OPTIONAL)),
             Some(Some(e)) => {
-                let s = quote!(#e).to_string();
+                let s = default_text(e);
                 quote!(::core::option::Option::Some(#s))
             }
         };
@@ -479,4 +479,23 @@ fn expand(input: &DeriveInput) -> syn::Result<Tokens> {
             }
         }
     })
+}
+
+/// A default as a path file would write it: an enum variant by its own name (`Y` for
+/// `Which::Y`), a negative number without the space `quote` puts after its sign (`-1.5`),
+/// any other expression as its tokens.
+fn default_text(e: &Expr) -> String {
+    match e {
+        Expr::Path(p) => p
+            .path
+            .segments
+            .last()
+            .map_or_else(|| quote!(#e).to_string(), |s| s.ident.to_string()),
+        Expr::Unary(syn::ExprUnary {
+            op: syn::UnOp::Neg(_),
+            expr,
+            ..
+        }) => format!("-{}", default_text(expr)),
+        _ => quote!(#e).to_string(),
+    }
 }

@@ -220,7 +220,8 @@ impl<'de> Visitor<'de> for OpSeed<'_, '_> {
         let Some(entry) = reader.registry.get(&name) else {
             let hint = match reader.registry.closest(&name) {
                 Some(near) => format!(" (did you mean `{near}`?)"),
-                None => String::new(),
+                // An operator of the user's own is read by a binary that registers it.
+                None => " (an operator of your own needs a binary that registers it: `cov_cli::run_with`, docs/paths.md)".to_string(),
             };
             return Err(de::Error::custom(format!(
                 "unknown operator `{}`{hint}; known operators: {}",
