@@ -78,10 +78,16 @@ fn explain(
     ) {
         return found;
     }
-    // An operator's parameters in the path author's words rather than the parser's.
+    // An operator's parameters in the path author's words rather than the parser's; a
+    // name outside a parameter's choices (an enum's variant) says which parameter.
     if !prefix.is_empty()
         && let Some(words) = parameter_words(&rest)
     {
+        if rest.starts_with("Unexpected enum variant")
+            && let Some((name, _, _)) = crate::scan::field_at(text, line, col)
+        {
+            return (line, col, format!("{prefix}parameter `{name}`: {words}"));
+        }
         return (line, col, format!("{prefix}{words}"));
     }
     if let Some(tail) = rest.strip_prefix("Found invalid std identifier \"") {
@@ -143,7 +149,14 @@ fn wrong_type(
     entry: Option<&crate::registry::Entry>,
 ) -> Option<(usize, usize, String)> {
     let (name, (l, c), value) = crate::scan::field_at(text, line, col)?;
-    let what = expected_value(rest, &value)?;
+    // Inside an operator, a name in quotes where a name belongs and a value where a list
+    // belongs (ron's "Expected identifier" also means a syntax error, as `,,`, hence the
+    // quote; outside an operator, the path's own fields are no parameters).
+    let what = match rest {
+        "Expected identifier" if !prefix.is_empty() && value.starts_with('"') => "a name, without quotes",
+        "Expected opening `[`" if !prefix.is_empty() => "a list in brackets, `[…]`",
+        _ => expected_value(rest, &value)?,
+    };
     let domain = entry
         .and_then(|e| e.params.iter().find(|p| p.name == name))
         .map(|p| p.domain)
@@ -205,6 +218,8 @@ fn parameter_words(rest: &str) -> Option<String> {
             .or_else(|| after.strip_prefix(", expected "))
             .and_then(|c| c.strip_suffix(" instead"))
     {
+        // serde says "either `a` or `b`" of two choices.
+        let choices = choices.strip_prefix("either ").unwrap_or(choices);
         return Some(format!("unknown name `{name}`: expected one of {choices}"));
     }
     if let Some((name, _)) = name_after("Unexpected missing field named `") {
