@@ -67,6 +67,22 @@ pub fn register_all<R: Registrar>(r: &mut R) {
 pub fn registry() -> cov_path::Registry {
     let mut r = cov_path::Registry::new();
     register_all(&mut r);
+    // The operator features this build leaves out, for the message about an unknown name.
+    let features = [
+        ("travel", cfg!(feature = "travel")),
+        ("occlusion", cfg!(feature = "occlusion")),
+        ("projection", cfg!(feature = "projection")),
+        ("curvature", cfg!(feature = "curvature")),
+        ("brdf", cfg!(feature = "brdf")),
+        ("refraction", cfg!(feature = "refraction")),
+        ("motion", cfg!(feature = "motion")),
+        ("defocus", cfg!(feature = "defocus")),
+        ("sensor", cfg!(feature = "sensor")),
+        ("media", cfg!(feature = "media")),
+    ];
+    for (f, _) in features.iter().filter(|(_, on)| !on) {
+        r.leave_out(f);
+    }
     r
 }
 

@@ -220,3 +220,34 @@ fn whole_number_parameters_take_plain_defaults_and_say_what_is_wrong() {
         assert!(err.contains(want), "{ops}: {err}");
     }
 }
+
+/// A build that leaves out operator features (`default-features = false`) says so when a
+/// file names an operator it does not know: the name may be one of those left out, and a
+/// near name it does know is no longer the only hint. The registry below is what such a
+/// build's `covtrace::registry()` gives: the travel operators alone, the others noted as
+/// left out.
+#[test]
+fn an_unknown_operator_names_the_features_left_out() {
+    let mut registry = covtrace::path::Registry::new();
+    covtrace::travel::spec::register(&mut registry);
+    registry.add::<BlurSpec>();
+    for f in ["brdf", "occlusion"] {
+        registry.leave_out(f);
+    }
+    let text = "Path(source: Gaussian(x: 0.1), operators: [Reflect(cos_in: 1.0, cos_out: 1.0)])";
+    let err = Path::parse(text, &registry).unwrap_err().to_string();
+    assert!(
+        err.contains("unknown operator `Reflect` (this build leaves out covtrace's features `brdf`, `occlusion`; an operator of your own needs a binary that registers it"),
+        "{err}"
+    );
+    // A near name is still offered, beside the features left out.
+    let err = Path::parse(&text.replace("Reflect", "Bur"), &registry)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        err.contains("(did you mean `Blur`? this build leaves out covtrace's features `brdf`, `occlusion`)"),
+        "{err}"
+    );
+    // The whole build leaves nothing out.
+    assert!(covtrace::registry().left_out().is_empty());
+}

@@ -218,10 +218,19 @@ impl<'de> Visitor<'de> for OpSeed<'_, '_> {
         let bare = reader.elements.get(ordinal).map(|e| e.bare);
         let (name, variant) = data.variant_seed(FieldName)?;
         let Some(entry) = reader.registry.get(&name) else {
-            let hint = match reader.registry.closest(&name) {
-                Some(near) => format!(" (did you mean `{near}`?)"),
+            let left_out = reader.registry.left_out();
+            let absent = (!left_out.is_empty()).then(|| {
+                let list: Vec<String> = left_out.iter().map(|f| format!("`{f}`")).collect();
+                format!("this build leaves out covtrace's features {}", list.join(", "))
+            });
+            let hint = match (reader.registry.closest(&name), absent) {
+                (Some(near), None) => format!(" (did you mean `{near}`?)"),
+                (Some(near), Some(absent)) => format!(" (did you mean `{near}`? {absent})"),
                 // An operator of the user's own is read by a binary that registers it.
-                None => " (an operator of your own needs a binary that registers it: `cov_cli::run_with`, docs/paths.md)".to_string(),
+                (None, absent) => format!(
+                    " ({}an operator of your own needs a binary that registers it: `cov_cli::run_with`, docs/paths.md)",
+                    absent.map(|a| format!("{a}; ")).unwrap_or_default()
+                ),
             };
             return Err(de::Error::custom(format!(
                 "unknown operator `{}`{hint}; known operators: {}",

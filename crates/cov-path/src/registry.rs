@@ -94,12 +94,27 @@ fn build_defaults<S: OperatorSpec>() -> Option<Result<Arc<dyn Operator>, CovErro
 #[derive(Clone, Debug, Default)]
 pub struct Registry {
     entries: BTreeMap<&'static str, Entry>,
+    left_out: Vec<&'static str>,
 }
 
 impl Registry {
     /// An empty registry.
     pub fn new() -> Self {
         Self::default()
+    }
+
+    /// Notes that this build leaves out the operators of a cargo feature (`covtrace`'s
+    /// `brdf`, say): a file that names an operator the registry does not know is then told
+    /// that it may be one of them.
+    pub fn leave_out(&mut self, feature: &'static str) {
+        if !self.left_out.contains(&feature) {
+            self.left_out.push(feature);
+        }
+    }
+
+    /// The features [`Registry::leave_out`] noted, in the order noted.
+    pub fn left_out(&self) -> &[&'static str] {
+        &self.left_out
     }
 
     /// The entry named `name`.
