@@ -15,7 +15,7 @@
 //! | struct | `#[operator(name = "…")]` | the name in files; default: the struct's name without `Spec` (`BlurSpec` → `Blur`) |
 //! | field | `/// text` | the parameter's documentation |
 //! | field | `#[param(unit = "m")]` | its unit |
-//! | field | `#[param(default)]`, `#[param(default = expr)]` | optional, with `Default::default()` or `expr` (taken as the field's type for a number: `default = 2` on a `u32`, `default = 1` on an `f64`) |
+//! | field | `#[param(default)]`, `#[param(default = expr)]` | optional, with `Default::default()` or `expr` (taken as the field's type for a number: `default = 2` on a `u32`, `default = 1` on an `f64`; a number outside the bounds written as numbers is a compile error) |
 //! | field | `#[param(positive)]`, `#[param(non_negative)]` | domain `> 0`, `≥ 0` |
 //! | field | `#[param(gt = a)]`, `ge`, `lt`, `le` (one lower, one upper) | bounds: numbers, constants or other fields (`gt = self.focal_length`) |
 //! | field | `#[param(finite)]` | finite; implied for `f64`, `Option<f64>`, `Vec<f64>`, `[f64; N]` |

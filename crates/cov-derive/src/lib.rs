@@ -10,7 +10,7 @@
 //! | `#[operator(summary = "…")]` | struct | one line for `covtrace list` (required) |
 //! | `/// text` | field | the parameter's documentation |
 //! | `#[param(unit = "m")]` | field | its unit (default: none) |
-//! | `#[param(default)]`, `#[param(default = expr)]` | field | optional, with `Default::default()` or `expr` (taken as the field's type for a number: `default = 2` on a `u32`) |
+//! | `#[param(default)]`, `#[param(default = expr)]` | field | optional, with `Default::default()` or `expr` (taken as the field's type for a number: `default = 2` on a `u32`; a number must lie inside the bounds written as numbers, or the derive refuses it) |
 //! | `#[param(nested)]` | field | a `Chain` written as an operator list (read with the caller's registry) |
 //! | `#[param(positive)]`, `#[param(non_negative)]` | field | domain `> 0`, `≥ 0` |
 //! | `#[param(gt = a, le = b)]` (and `ge`, `lt`) | field | bounds; `a`, `b` are numbers or other fields (`gt = self.focal_length`) |
@@ -92,6 +92,23 @@ impl Bound {
             Bound::Lt => "<",
             Bound::Le => "≤",
         }
+    }
+}
+
+/// The value of a number written as a literal (`2`, `0.5`, `-1e-3`); `None` for any
+/// other expression (a field, a constant).
+fn literal(e: &Expr) -> Option<f64> {
+    match e {
+        Expr::Lit(syn::ExprLit {
+            lit: syn::Lit::Int(i),
+            ..
+        }) => i.base10_digits().parse().ok(),
+        Expr::Lit(syn::ExprLit {
+            lit: syn::Lit::Float(f),
+            ..
+        }) => f.base10_digits().parse().ok(),
+        Expr::Unary(u) if matches!(u.op, syn::UnOp::Neg(_)) => literal(&u.expr).map(|v| -v),
+        _ => None,
     }
 }
 
@@ -303,6 +320,31 @@ fn expand(input: &DeriveInput) -> syn::Result<Tokens> {
                 }
                 Ok(())
             })?;
+        }
+        // A number written as the default must lie in the bounds written as numbers: a
+        // file that leaves the parameter out would be refused at a value it never wrote.
+        if let Some(Some(e)) = &default
+            && let Some(d) = literal(e)
+        {
+            for (kind, b) in &bounds {
+                let Some(v) = literal(b) else { continue };
+                let (inside, words) = match kind {
+                    Bound::Gt => (d > v, ">"),
+                    Bound::Ge => (d >= v, "≥"),
+                    Bound::Lt => (d < v, "<"),
+                    Bound::Le => (d <= v, "≤"),
+                };
+                if !inside {
+                    return Err(syn::Error::new(
+                        e.span(),
+                        format!(
+                            "the default {} is outside the parameter's domain: it must be {words} {}",
+                            default_text(e),
+                            default_text(b)
+                        ),
+                    ));
+                }
+            }
         }
         let name = ident.to_string().trim_start_matches("r#").to_string();
         let checked = finite || !bounds.is_empty() || is_float(&f.ty);
