@@ -26,29 +26,37 @@ pub use cov_core::*;
 #[cfg(feature = "path")]
 pub use cov_path as path;
 
-/// Registers every operator compiled in (one feature per operator crate) with `r`.
-pub fn register_all<R: Registrar>(r: &mut R) {
-    let _ = &r;
-    #[cfg(feature = "travel")]
-    cov_travel::spec::register(r);
-    #[cfg(feature = "occlusion")]
-    cov_occlusion::spec::register(r);
-    #[cfg(feature = "projection")]
-    cov_projection::spec::register(r);
-    #[cfg(feature = "curvature")]
-    cov_curvature::spec::register(r);
-    #[cfg(feature = "brdf")]
-    cov_brdf::spec::register(r);
-    #[cfg(feature = "refraction")]
-    cov_refraction::spec::register(r);
-    #[cfg(feature = "motion")]
-    cov_motion::spec::register(r);
-    #[cfg(feature = "defocus")]
-    cov_defocus::spec::register(r);
-    #[cfg(feature = "sensor")]
-    cov_sensor::spec::register(r);
-    #[cfg(feature = "media")]
-    cov_media::spec::register(r);
+/// Each operator feature with its crate, named once: what [`register_all`] registers and
+/// what [`registry`] notes as left out.
+macro_rules! operator_features {
+    ($($feature:literal => $krate:ident),* $(,)?) => {
+        /// Registers every operator compiled in (one feature per operator crate) with `r`.
+        pub fn register_all<R: Registrar>(r: &mut R) {
+            let _ = &r;
+            $(
+                #[cfg(feature = $feature)]
+                $krate::spec::register(r);
+            )*
+        }
+
+        /// The operator features this build leaves out, for the message about an unknown
+        /// operator's name.
+        #[cfg(feature = "path")]
+        const LEFT_OUT: &[&str] = &[$(#[cfg(not(feature = $feature))] $feature,)*];
+    };
+}
+
+operator_features! {
+    "travel" => cov_travel,
+    "occlusion" => cov_occlusion,
+    "projection" => cov_projection,
+    "curvature" => cov_curvature,
+    "brdf" => cov_brdf,
+    "refraction" => cov_refraction,
+    "motion" => cov_motion,
+    "defocus" => cov_defocus,
+    "sensor" => cov_sensor,
+    "media" => cov_media,
 }
 
 /// A registry with every operator this build includes (one per enabled feature).
@@ -67,20 +75,7 @@ pub fn register_all<R: Registrar>(r: &mut R) {
 pub fn registry() -> cov_path::Registry {
     let mut r = cov_path::Registry::new();
     register_all(&mut r);
-    // The operator features this build leaves out, for the message about an unknown name.
-    let features = [
-        ("travel", cfg!(feature = "travel")),
-        ("occlusion", cfg!(feature = "occlusion")),
-        ("projection", cfg!(feature = "projection")),
-        ("curvature", cfg!(feature = "curvature")),
-        ("brdf", cfg!(feature = "brdf")),
-        ("refraction", cfg!(feature = "refraction")),
-        ("motion", cfg!(feature = "motion")),
-        ("defocus", cfg!(feature = "defocus")),
-        ("sensor", cfg!(feature = "sensor")),
-        ("media", cfg!(feature = "media")),
-    ];
-    for (f, _) in features.iter().filter(|(_, on)| !on) {
+    for f in LEFT_OUT {
         r.leave_out(f);
     }
     r
