@@ -41,7 +41,7 @@ use cov_occlusion::{BlockerEdge, Texture};
 use cov_projection::{RotateFrame, Unproject};
 use cov_sensor::{PixelRates, Sensor, SensorParams};
 use cov_travel::Travel;
-use glam::DVec3;
+use glam::{DVec2, DVec3};
 use rand::Rng;
 
 use crate::geometry::Hit;
@@ -232,7 +232,21 @@ fn texture_window(
     // The moments are the pyramid's averages (finite, `mean_sq ≥ 0`, gradients PSD by
     // construction): their spectra are made unchecked, and the envelope is checked once,
     // below.
-    for m in tex.moments(hit.uv, band * per_m, region * per_m) {
+    // The region: the block's footprint, a square of side `region · cos_o` across the ray
+    // (`region` is its length on the surface along the plane of incidence) turned as the
+    // image's columns are, carried to (u, v) by J, the surface's own map; a square in
+    // (u, v) scaled by the map's mean stretch covered other areas of the surface where
+    // the map stretches `u` and `v` differently (a sphere, a long quad), and the whole
+    // stretched length across the plane of incidence too.
+    let side = region * cos_o;
+    let right = world.camera.right - d_out * world.camera.right.dot(d_out);
+    let (cx, cy) = match right.try_normalize() {
+        Some(r) => (r.dot(x_out), r.dot(e2)),
+        None => (1.0, 0.0),
+    };
+    let uv_of = |x: f64, y: f64| DVec2::new(j[0][0] * x + j[0][1] * y, j[1][0] * x + j[1][1] * y);
+    let edges = [uv_of(side * cx, side * cy), uv_of(-side * cy, side * cx)];
+    for m in tex.moments(hit.uv, band * per_m, edges) {
         let [xx, xy, yy] = Texture::moments_spectrum(m.mean, m.mean_sq, m.grad);
         e[0] = e[0].max(xx);
         e[2] = e[2].max(yy);

@@ -326,10 +326,13 @@ impl TextureMap {
     /// The luminance statistics of the texture band-limited at `band` (the finest detail
     /// kept, units of `u, v`: the level whose texels are that wide, interpolated linearly
     /// between the two levels around it as the colour is), each over a 3×3-texel
-    /// neighbourhood there, on a grid of at most [`MAX_REGION_GRID`]² points that covers a
-    /// square of side `region` around `uv` (spaced by the neighbourhoods' width at the
-    /// nearer level where the cap allows), with derivatives per unit of the surface's `u`
-    /// and `v` (the repeat included).
+    /// neighbourhood there, on a grid of at most [`MAX_REGION_GRID`]² points that covers
+    /// the parallelogram `uv + a·edges[0] + b·edges[1]`, `a, b ∈ [−½, ½]` (units of `u,
+    /// v`; the block's footprint, mapped by the surface's own `(u, v)` map, so that a map
+    /// stretched more along `u` than along `v` covers the same area of the surface),
+    /// spaced along each edge by the neighbourhoods' width at the nearer level where the
+    /// cap allows, with derivatives per unit of the surface's `u` and `v` (the repeat
+    /// included).
     ///
     /// A step's derivatives grow as its level's texels shrink, so the nearer level alone
     /// made the prediction jump where the footprint crosses halfway between two levels:
@@ -337,17 +340,28 @@ impl TextureMap {
     /// the middle of the image, and the Σ filter outside it blurred the checks (relMSE
     /// 5.8e-2 against 2.0e-2 to 2.8e-2 interpolated, 16 spp; docs/render-bench.md, "A
     /// texture finer than the pixels").
-    pub fn moments(&self, uv: DVec2, band: f64, region: f64) -> impl Iterator<Item = Moments> + '_ {
+    pub fn moments(&self, uv: DVec2, band: f64, edges: [DVec2; 2]) -> impl Iterator<Item = Moments> + '_ {
         let get = |l: &Level, i: usize| l.mom[i].map(f64::from);
         let lev = self.level(band);
-        // The lookups are spaced by the neighbourhoods of the nearer level.
+        // The lookups are spaced by the neighbourhoods of the nearer level: an edge's
+        // length in its texels, over three.
         let l = &self.levels[lev.round() as usize];
-        let texel = 1.0 / (self.repeat.x * l.w as f64).min(self.repeat.y * l.h as f64);
-        let k = ((region / (3.0 * texel)).ceil() as usize).clamp(1, MAX_REGION_GRID);
         let (ru, rv) = (self.repeat.x, self.repeat.y);
-        (0..k * k).map(move |n| {
-            let off = DVec2::new((n % k) as f64 + 0.5, (n / k) as f64 + 0.5) / k as f64 - 0.5;
-            let at = (uv + off * region) * self.repeat;
+        let texels = DVec2::new(ru * l.w as f64, rv * l.h as f64);
+        let count = |e: DVec2| {
+            let n = ((e * texels).length() / 3.0).ceil();
+            // NaN (a degenerate map) and 0 take one lookup.
+            if n >= 1.0 {
+                (n as usize).min(MAX_REGION_GRID)
+            } else {
+                1
+            }
+        };
+        let (ka, kb) = (count(edges[0]), count(edges[1]));
+        (0..ka * kb).map(move |n| {
+            let a = ((n % ka) as f64 + 0.5) / ka as f64 - 0.5;
+            let b = ((n / ka) as f64 + 0.5) / kb as f64 - 0.5;
+            let at = (uv + edges[0] * a + edges[1] * b) * self.repeat;
             let m = self.lookup(lev, at, get);
             Moments {
                 mean: m[0],
@@ -611,7 +625,7 @@ mod tests {
     }
 
     fn one(t: &TextureMap, uv: DVec2, band: f64) -> Moments {
-        let v: Vec<Moments> = t.moments(uv, band, 0.0).collect();
+        let v: Vec<Moments> = t.moments(uv, band, [DVec2::ZERO; 2]).collect();
         assert_eq!(v.len(), 1);
         v[0]
     }
@@ -642,7 +656,13 @@ mod tests {
         assert!((m.mean - 0.5).abs() < 1e-6 && m.grad == [0.0; 3], "{m:?}");
         // Band-limited at full resolution, over a region of two squares: lookups on both
         // colours, and on the edge between them.
-        let ms: Vec<Moments> = t.moments(DVec2::new(0.25, 0.125), 0.0, 0.5).collect();
+        let ms: Vec<Moments> = t
+            .moments(
+                DVec2::new(0.25, 0.125),
+                0.0,
+                [DVec2::new(0.5, 0.0), DVec2::new(0.0, 0.5)],
+            )
+            .collect();
         assert!(ms.len() > 1 && ms.len() <= MAX_REGION_GRID * MAX_REGION_GRID);
         assert!(
             ms.iter().any(|m| (m.mean - 0.2).abs() < 1e-6) && ms.iter().any(|m| (m.mean - 0.8).abs() < 1e-6)

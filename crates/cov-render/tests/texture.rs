@@ -196,3 +196,43 @@ fn the_guard_protects_a_blind_pass() {
         "1 spp: seen {seen_1} uniform {uniform_1}"
     );
 }
+
+/// Four stripes across a floor 1 m deep (0.125 m wide, running across the view), seen at
+/// a slant, in focus, on a quad `width` metres wide: its (u, v) map stretches `u` by
+/// `width` and `v` by 1 m. The camera sees the middle 0.7 m only, so every `width` shows
+/// the same floor.
+fn stripes_floor(width: f64) -> String {
+    format!(
+        r#"Scene(
+        camera: (position: (0.0, 1.2, 1.0), look_at: (0.0, 0.0, 0.0), fov: 25.0, width: 96, height: 72),
+        textures: {{ "s": Stripes(count: 4, duty: 0.5, a: (0.8, 0.8, 0.8), b: (0.1, 0.1, 0.1), size: 64) }},
+        materials: {{ "s": Diffuse(albedo: (1.0, 1.0, 1.0), texture: "s") }},
+        lights: [Rect(corner: (-1.0, 2.0, -1.0), edge_u: (2.0, 0.0, 0.0), edge_v: (0.0, 0.0, 2.0), radiance: (3.0, 3.0, 3.0))],
+        shapes: [Quad(corner: ({x0}, 0.0, 0.5), edge_u: ({width}, 0.0, 0.0), edge_v: (0.0, 0.0, -1.0), material: "s")],
+    )"#,
+        x0 = -width / 2.0
+    )
+}
+
+/// The covariance pass reads a texture over the block's own footprint on the surface,
+/// whatever the (u, v) map: the same floor mapped by a square map and by a map stretched
+/// four times along `u` gives the same predictions. Before, the footprint was a square in
+/// (u, v) scaled by the map's mean stretch: on the stretched map it reached twice as far
+/// across the stripes, and blocks with no stripe edge near them predicted one.
+#[test]
+fn a_stretched_uv_map_reads_the_same_footprint() {
+    let square = world(&stripes_floor(1.0));
+    let stretched = world(&stripes_floor(4.0));
+    // The mean predicted content along the image's columns (cycles/px)², where the
+    // stripes' edges are (a flat floor predicts 0 there).
+    let content = |w: &World| -> f64 {
+        let maps = covariance_maps(w, 1, 4, 1, None).unwrap();
+        let yy = |p: &cov_render::covpass::PixelCov| {
+            cov_render::adaptive::content(p.sigma, cov_render::adaptive::PIXEL_FILTER)[2]
+        };
+        maps.pixels.iter().map(yy).sum::<f64>() / maps.pixels.len() as f64
+    };
+    let (a, b) = (content(&square), content(&stretched));
+    assert!(a > 1e-3, "square map: {a}");
+    assert!((b - a).abs() < 0.05 * a, "square map {a}, stretched map {b}");
+}
