@@ -370,10 +370,16 @@ pub fn bar(len: usize, what: &str) -> ProgressBar {
 /// Loads the scene of `covtrace render`, `render-check` or `render-bench`, at `size` when
 /// given.
 ///
+/// The scene's warnings ([`World::warnings`]) go to the standard error, one line each,
+/// beside the errors.
+///
 /// # Errors
 /// The scene's own error, one positioned line.
 pub fn load(scene: &Path, size: Option<(u32, u32)>) -> Result<World, String> {
     let world = World::load(scene).map_err(|e| e.to_string())?;
+    for w in &world.warnings {
+        eprintln!("warning: {}: {w}", world.file);
+    }
     Ok(match size {
         Some((w, h)) => world.with_resolution(w, h),
         None => world,

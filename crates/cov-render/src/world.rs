@@ -313,6 +313,11 @@ pub struct World {
     /// Whether anything moves during an open shutter (the covariance is then traced with
     /// a time axis, layout 5; else layout 4).
     pub has_motion: bool,
+    /// What the scene asks for that is read otherwise than its file may suggest, one line
+    /// each, for the user (an OBJ whose `usemtl` lines name several materials, which a
+    /// mesh does not read). The scene loads and renders; `covtrace` prints them as
+    /// warnings.
+    pub warnings: Vec<String>,
 }
 
 impl World {
@@ -454,8 +459,17 @@ impl World {
             .add(&prims, 0, (t0, t1), desc.lights.ordinal)
             .map_err(|(o, m)| at(o, m))?;
         let names = Names(&material_names, "material");
-        let any_velocity = shapes(&desc, &names, dir, &mut prims, (t0, t1), &mut boxes)
-            .map_err(|(o, m)| at(o, m))?
+        let mut warnings = Vec::new();
+        let any_velocity = shapes(
+            &desc,
+            &names,
+            dir,
+            &mut prims,
+            (t0, t1),
+            &mut boxes,
+            &mut warnings,
+        )
+        .map_err(|(o, m)| at(o, m))?
             || camera.velocity != DVec3::ZERO;
         large_enough(&desc).map_err(|(o, m)| at(o, m))?;
         let inputs = input_files(&desc, dir);
@@ -472,6 +486,7 @@ impl World {
             textures,
             lights,
             geometry: Geometry::new(prims, t0, t1),
+            warnings,
         })
     }
 }
@@ -1065,11 +1080,12 @@ fn shapes(
     prims: &mut Vec<Prim>,
     (t0, t1): (f64, f64),
     boxes: &mut SharedBoxes,
+    warnings: &mut Vec<String>,
 ) -> Result<bool, Failure> {
     let mut triangles = 0usize;
     let mut any_velocity = false;
     // Each OBJ file is read once, however many meshes place it.
-    let mut read: HashMap<std::path::PathBuf, Vec<ObjTriangle>> = HashMap::new();
+    let mut read: HashMap<std::path::PathBuf, Obj> = HashMap::new();
     for s in &desc.shapes {
         let from = prims.len();
         let (material, velocity) = match s {
@@ -1115,16 +1131,35 @@ fn shapes(
                 obj,
                 translate,
                 scale,
+                material,
                 ..
             } => {
                 let in_obj = |e: String| (obj.ordinal, format!("OBJ `{}`: {e}", crate::echo(&obj.value)));
-                let tris = match read.entry(dir.join(&obj.value)) {
+                let Obj {
+                    triangles: tris,
+                    usemtl,
+                } = match read.entry(dir.join(&obj.value)) {
                     Entry::Occupied(e) => e.into_mut(),
                     Entry::Vacant(e) => {
                         let tris = load_obj(e.key(), MAX_TRIANGLES - triangles).map_err(in_obj)?;
                         e.insert(tris)
                     }
                 };
+                if usemtl.len() > 1 {
+                    let listed: Vec<String> = usemtl
+                        .iter()
+                        .take(4)
+                        .map(|n| format!("`{}`", crate::echo(n)))
+                        .collect();
+                    let more = if usemtl.len() > 4 { ", …" } else { "" };
+                    warnings.push(format!(
+                        "OBJ `{}` names {} materials with `usemtl` ({}{more}); a mesh has one material, so all of it is `{}` (one OBJ file per material, one `Mesh` each, gives each its own)",
+                        crate::echo(&obj.value),
+                        usemtl.len(),
+                        listed.join(", "),
+                        crate::echo(&material.value)
+                    ));
+                }
                 if tris.len() > MAX_TRIANGLES - triangles {
                     return Err(in_obj(too_many_triangles()));
                 }
@@ -1184,6 +1219,13 @@ const QUAD_UV: [[DVec2; 3]; 2] = [
 
 type ObjTriangle = ([DVec3; 3], Option<[DVec3; 3]>, Option<[DVec2; 3]>);
 
+/// An OBJ file as a mesh reads it: its triangles, and the distinct names its `usemtl`
+/// lines give (which the mesh does not read: the scene gives it one material).
+struct Obj {
+    triangles: Vec<ObjTriangle>,
+    usemtl: Vec<String>,
+}
+
 /// The message of a scene past [`MAX_TRIANGLES`], whether one file or its placements
 /// bring it there.
 fn too_many_triangles() -> String {
@@ -1191,8 +1233,8 @@ fn too_many_triangles() -> String {
 }
 
 /// Triangles (with vertex normals and texture coordinates when the file has them) of an
-/// OBJ file, at most `limit`.
-fn load_obj(path: &Path, limit: usize) -> Result<Vec<ObjTriangle>, String> {
+/// OBJ file, at most `limit`, and the names of its `usemtl` statements.
+fn load_obj(path: &Path, limit: usize) -> Result<Obj, String> {
     crate::error::regular_file(path)?;
     let opts = tobj::LoadOptions {
         triangulate: true,
@@ -1274,7 +1316,21 @@ fn load_obj(path: &Path, limit: usize) -> Result<Vec<ObjTriangle>, String> {
             "every triangle of the file has zero area (a face of two points, or three in a line)".into(),
         );
     }
-    Ok(out)
+    // The reader keeps no material name without a material library, which is not
+    // followed: the statements' names, in the order they first appear.
+    let mut usemtl: Vec<String> = Vec::new();
+    for line in text.lines() {
+        if let Some(("usemtl", name)) = line.trim_start().split_once(char::is_whitespace) {
+            let name = name.trim();
+            if !name.is_empty() && !usemtl.iter().any(|n| n == name) {
+                usemtl.push(name.to_string());
+            }
+        }
+    }
+    Ok(Obj {
+        triangles: out,
+        usemtl,
+    })
 }
 
 /// The reader's error in words that say which statement of the file is wrong (the reader

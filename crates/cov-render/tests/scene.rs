@@ -616,3 +616,35 @@ fn an_unusual_space_is_named_where_it_stands() {
     let commented = scene(&[("FOV", "40.0 /* a\u{a0}b */")]);
     assert!(World::from_text(&commented, "s.ron", Path::new(".")).is_ok());
 }
+
+/// An OBJ whose `usemtl` lines name several materials loads with one material, the
+/// scene's, and says so in one warning; one named material is no warning (the mesh's
+/// material is the scene's choice).
+#[test]
+fn an_obj_of_several_materials_is_a_warning() {
+    let dir = std::env::temp_dir().join(format!("covtrace-usemtl-test-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).expect("temp dir");
+    let two =
+        "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nusemtl light\nf 1 2 3\n  usemtl\tdark\nf 2 4 3\nusemtl light\n";
+    std::fs::write(dir.join("two.obj"), two).expect("write");
+    std::fs::write(
+        dir.join("one.obj"),
+        "v 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl light\nf 1 2 3\n",
+    )
+    .expect("write");
+    let world = |obj: &str| {
+        let text = scene(&[("SHAPE", &format!(r#"Mesh(obj: "{obj}", material: "w")"#))]);
+        World::from_text(&text, "s.ron", &dir).expect("the mesh loads")
+    };
+    let w = world("two.obj");
+    assert_eq!(w.warnings.len(), 1, "{:?}", w.warnings);
+    let m = &w.warnings[0];
+    assert!(
+        m.contains("OBJ `two.obj` names 2 materials with `usemtl` (`light`, `dark`)")
+            && m.contains("all of it is `w`")
+            && !m.contains('\n'),
+        "{m}"
+    );
+    assert!(world("one.obj").warnings.is_empty());
+    let _ = std::fs::remove_dir_all(&dir);
+}
