@@ -6,12 +6,12 @@
 //!         position: (0.0, 1.0, 4.0), look_at: (0.0, 1.0, 0.0),
 //!         fov: 40.0,                       // horizontal, degrees
 //!         width: 160, height: 120,
-//!         lens: Some((aperture: 0.03, focus_distance: 4.0)),   // left out: a pinhole
-//!         shutter: Some((open: 0.0, close: 0.02)),             // left out: no time axis
+//!         lens: (aperture: 0.03, focus_distance: 4.0),   // aperture: the lens radius (m); left out: a pinhole
+//!         shutter: (open: 0.0, close: 0.02),             // left out: no time axis
 //!     ),
 //!     materials: { "white": Diffuse(albedo: (0.7, 0.7, 0.7)) },
 //!     lights: [Rect(corner: (-0.3, 1.99, -0.3), edge_u: (0.6, 0.0, 0.0), edge_v: (0.0, 0.0, 0.6), radiance: (15.0, 15.0, 15.0))],
-//!     shapes: [Sphere(center: (0.0, 0.5, 0.0), radius: 0.5, material: "white", velocity: Some((0.5, 0.0, 0.0)))],
+//!     shapes: [Sphere(center: (0.0, 0.5, 0.0), radius: 0.5, material: "white", velocity: (0.5, 0.0, 0.0))],
 //! )
 //! ```
 //!
