@@ -233,7 +233,8 @@ fn texture_window(
     // construction): their spectra are made unchecked, and the envelope is checked once,
     // below.
     // The region: the block's footprint, a square of side `region · cos_o` across the ray
-    // (`region` is its length on the surface along the plane of incidence) turned as the
+    // (`region` is its length on the surface along the plane of incidence, as
+    // `footprints` gives it, so the product is twice the block's side there) turned as the
     // image's columns are, carried to (u, v) by J, the surface's own map; a square in
     // (u, v) scaled by the map's mean stretch covered other areas of the surface where
     // the map stretches `u` and `v` differently (a sphere, a long quad), and the whole
