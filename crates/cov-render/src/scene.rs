@@ -31,7 +31,7 @@
 //! | `camera.velocity` | m/s | camera motion during the shutter; the camera stays within ±[`crate::geometry::MAX_COORD`] of the origin over it (and at every frame rendered) |
 //! | `camera.frame_rate` | 1/s | frames per second of an animation (`--frame K` moves the shutter and a still's instant by `K / frame_rate`), default 24 |
 //! | `textures` | | named `Checker(checks, a, b)`, `Stripes(count, duty, a, b)`, `Noise(cells, a, b, seed)` (generated; `size` texels per side, default 1024), `Image(file)` (PNG, sRGB, 8 or 16 bits, grey or colour, its alpha ignored; or EXR, linear, with R, G and B channels or one grey channel Y; relative to the scene file; texels clamped to 0 to 1, NaN to 0); all take `repeat: (u, v)` |
-//! | `materials` | | named `Diffuse(albedo)`, `Phong(albedo, exponent)`, `Ggx(albedo, alpha)`, each with an optional `texture` that multiplies the albedo |
+//! | `materials` | | named `Diffuse(albedo)`, `Phong(albedo, exponent)` (exponent 0 to 1e12), `Ggx(albedo, alpha)` (alpha at least 1e-6: a narrower lobe is below what f64 resolves), each with an optional `texture` that multiplies the albedo |
 //! | `lights` | | `Rect(corner, edge_u, edge_v, radiance)`, `Sphere(center, radius, radiance)`; radiance in W/(m² sr) per channel |
 //! | `shapes` | | `Sphere(center, radius, material, velocity)`, `Quad(corner, edge_u, edge_v, material, velocity)`, `Mesh(obj, material, translate, scale, velocity)` (one material for the whole mesh: the OBJ's `mtllib` and `usemtl` lines are not read, and `usemtl` lines naming several materials are a warning: split such a file, one OBJ and one `Mesh` per material; a mesh without texture coordinates `vt` reads its material's texture at `(0, 0)`) |
 //! | colours (`albedo`, texture colours, `radiance`) | | each entry 0 to [`MAX_COLOUR`] (1e9) |
@@ -302,7 +302,7 @@ pub enum MaterialDesc {
     Phong {
         /// Reflectance per channel.
         albedo: Rgb,
-        /// Exponent ≥ 0.
+        /// Exponent, 0 to 1e12 (`world::MIN_LOBE_WIDTH`).
         exponent: NonNegative,
         /// A texture from `textures` that multiplies the albedo.
         #[serde(default)]
@@ -312,7 +312,7 @@ pub enum MaterialDesc {
     Ggx {
         /// Reflectance per channel.
         albedo: Rgb,
-        /// Roughness > 0.
+        /// Roughness, at least 1e-6 (`world::MIN_LOBE_WIDTH`).
         alpha: Positive,
         /// A texture from `textures` that multiplies the albedo.
         #[serde(default)]

@@ -200,6 +200,13 @@ impl TextureMap {
     pub fn load(path: &Path, repeat: DVec2) -> Result<TextureMap, String> {
         let one = |e: &dyn std::fmt::Display| cov_core::one_line(&e.to_string());
         crate::error::regular_file(path)?;
+        let limit = crate::world::MAX_TEXTURE_BYTES;
+        let len = std::fs::metadata(path).map_err(|e| one(&e))?.len();
+        if len > limit {
+            return Err(format!(
+                "the file is {len} bytes; texture files are read up to {limit} bytes"
+            ));
+        }
         // By content, then by extension; anything but PNG and EXR is named as such.
         let open = || {
             let r = image::ImageReader::open(path)
@@ -305,6 +312,13 @@ impl TextureMap {
         st: DVec2,
         get: impl Fn(&Level, usize) -> [f64; K],
     ) -> [f64; K] {
+        // Coordinates past f64 (a huge repeat times a huge uv) average the texture over
+        // its every repeat: the mean, the top level's one texel.
+        let (lev, st) = if st.is_finite() {
+            (lev, st)
+        } else {
+            ((self.levels.len() - 1) as f64, DVec2::ZERO)
+        };
         let l0 = lev.floor() as usize;
         let t = lev - l0 as f64;
         let a = self.levels[l0].bilinear(st, &get);

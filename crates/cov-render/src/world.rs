@@ -663,6 +663,18 @@ pub const DEFAULT_TEXTURE_SIZE: u32 = 1024;
 /// Each texture alone is bounded by its side; without this, a few kilobytes of scene
 /// asked for tens of gigabytes.
 pub const MAX_SCENE_TEXELS: usize = 2 * 4096 * 4096;
+/// Narrowest lobe a material may have, as an angular std (rad): GGX `alpha` at least
+/// this, Phong `exponent` at most its inverse square (1e12). f64 resolves a direction near
+/// the normal to about √ε ≈ 1.5e-8 rad (the cosine of a smaller angle rounds to 1), and the
+/// BRDF's half-vector is recomputed from the two directions, so a lobe within a few times
+/// that evaluates to nothing where it should peak: a new user's GGX floor of `alpha`
+/// 1e-10, or Phong of exponent 1e20, lost its lights' reflections without a word. 1e-6
+/// leaves a margin of about 70.
+pub const MIN_LOBE_WIDTH: f64 = 1e-6;
+/// Largest texture image file read (bytes): eight f32 channels at the largest side
+/// ([`crate::texture::MAX_TEXTURE_SIDE`]), 512 MiB. The file is hashed into the scene's
+/// fingerprint as well as decoded; a PNG padded past its end was read whole.
+pub const MAX_TEXTURE_BYTES: u64 = 512 << 20;
 /// Largest OBJ file read (bytes): about 70 bytes a triangle for [`MAX_TRIANGLES`].
 pub const MAX_OBJ_BYTES: u64 = 350 << 20;
 
@@ -848,6 +860,29 @@ fn materials(desc: &SceneFile, textures: &Names<'_>) -> Result<Materials, Failur
                 name.ordinal,
                 format!(
                     "material `{}`: an albedo above 1 reflects more than it receives",
+                    crate::echo(&name.value)
+                ),
+            ));
+        }
+        let narrow = match mat {
+            Material::Ggx { alpha, .. } if alpha < MIN_LOBE_WIDTH => Some(format!(
+                "alpha {} is below {MIN_LOBE_WIDTH:e}",
+                cov_core::num(alpha)
+            )),
+            Material::Phong { exponent, .. } if exponent > 1.0 / (MIN_LOBE_WIDTH * MIN_LOBE_WIDTH) => {
+                Some(format!(
+                    "exponent {} is above {:e}",
+                    cov_core::num(exponent),
+                    1.0 / (MIN_LOBE_WIDTH * MIN_LOBE_WIDTH)
+                ))
+            }
+            _ => None,
+        };
+        if let Some(what) = narrow {
+            return Err((
+                name.ordinal,
+                format!(
+                    "material `{}`: {what}, a lobe narrower than f64 resolves directions (its reflections would vanish)",
                     crate::echo(&name.value)
                 ),
             ));
@@ -1382,9 +1417,20 @@ fn fingerprint(text: &str, files: &[std::path::PathBuf]) -> u64 {
     h.write(text.as_bytes());
     for f in files {
         h.write(&[0xff]);
-        match std::fs::read(f) {
-            Ok(bytes) => h.write(&bytes),
-            Err(_) => h.write(f.display().to_string().as_bytes()),
+        // In chunks: the hash of the bytes as one write, in bounded memory.
+        let mut read = || -> std::io::Result<()> {
+            use std::io::Read;
+            let mut file = std::fs::File::open(f)?;
+            let mut buf = vec![0u8; 1 << 16];
+            loop {
+                match file.read(&mut buf)? {
+                    0 => return Ok(()),
+                    n => h.write(&buf[..n]),
+                }
+            }
+        };
+        if read().is_err() {
+            h.write(f.display().to_string().as_bytes());
         }
     }
     h.finish()

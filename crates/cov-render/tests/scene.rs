@@ -51,7 +51,7 @@ fn error(text: &str) -> String {
 
 #[test]
 fn checks_after_parsing_point_at_the_value() {
-    let cases: [(&[(&str, &str)], &str); 11] = [
+    let cases: [(&[(&str, &str)], &str); 13] = [
         (
             &[("LOOK", "(0.0, 1.0, 3.0)")],
             "2:50: the camera looks at its own position",
@@ -82,6 +82,18 @@ fn checks_after_parsing_point_at_the_value() {
         (
             &[("MAT", r#""hot": Diffuse(albedo: (2.0, 0.5, 0.5))"#)],
             "3:57: material `hot`: an albedo above 1",
+        ),
+        // Lobes narrower than f64 resolves directions lost their reflections unsaid.
+        (
+            &[("MAT", r#""glass": Ggx(albedo: (0.5, 0.5, 0.5), alpha: 1e-10)"#)],
+            "3:57: material `glass`: alpha 1e-10 is below 1e-6, a lobe narrower than f64 resolves",
+        ),
+        (
+            &[(
+                "MAT",
+                r#""glass": Phong(albedo: (0.5, 0.5, 0.5), exponent: 1e20)"#,
+            )],
+            "3:57: material `glass`: exponent 1e20 is above 1e12, a lobe narrower",
         ),
         (&[("LIGHTS", "[]")], "4:13: the scene has no light"),
         (

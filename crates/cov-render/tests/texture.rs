@@ -87,6 +87,49 @@ fn image_textures_load_relative_to_the_scene() {
     std::fs::remove_dir_all(&dir).ok();
 }
 
+/// A texture file past its size limit is refused from its length, before it is read (a
+/// PNG padded to 4 GB past its end was read whole into memory for the scene's
+/// fingerprint, 4.2 GB resident for a 64×48 render); the file here is sparse.
+#[test]
+fn a_padded_texture_file_is_refused_unread() {
+    let dir = std::env::temp_dir().join(format!("covtrace-pad-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let img = image::RgbImage::from_fn(2, 1, |x, _| image::Rgb([if x == 0 { 0 } else { 255 }; 3]));
+    img.save(dir.join("pad.png")).unwrap();
+    let f = std::fs::OpenOptions::new()
+        .write(true)
+        .open(dir.join("pad.png"))
+        .unwrap();
+    f.set_len(cov_render::world::MAX_TEXTURE_BYTES + 1).unwrap();
+    let text = board(0.25, 8, 8).replace(
+        "Checker(checks: (4, 4), a: (0.8, 0.8, 0.8), b: (0.1, 0.1, 0.1), size: 512)",
+        "Image(file: \"pad.png\")",
+    );
+    let e = World::from_text(&text, "s.ron", &dir).unwrap_err().to_string();
+    std::fs::remove_dir_all(&dir).ok();
+    assert_eq!(
+        e,
+        format!(
+            "s.ron:3:42: texture `board`: the file is {} bytes; texture files are read up to {} bytes",
+            cov_render::world::MAX_TEXTURE_BYTES + 1,
+            cov_render::world::MAX_TEXTURE_BYTES
+        )
+    );
+}
+
+/// Texture coordinates past f64 (a repeat of 1e300 on a mesh whose `vt` reach 3e38) read
+/// the texture's mean, its average over every repeat, where they read NaN and the mesh
+/// rendered black.
+#[test]
+fn coordinates_past_f64_read_the_mean() {
+    let (a, b) = (glam::DVec3::splat(0.9), glam::DVec3::splat(0.1));
+    let t = cov_render::texture::TextureMap::checker((8, 8), a, b, 64, glam::DVec2::splat(1e300)).unwrap();
+    for uv in [glam::DVec2::splat(3e38), glam::DVec2::new(f64::INFINITY, 0.5)] {
+        let c = t.rgb(uv, 0.0);
+        assert!((c - (a + b) / 2.0).length() < 1e-6, "{uv}: {c}");
+    }
+}
+
 #[test]
 fn the_tracer_sees_the_texture() {
     // 4 checks across the board, 96 px wide: a check is about 15 px.
