@@ -1269,6 +1269,20 @@ fn too_many_triangles() -> String {
 
 /// Triangles (with vertex normals and texture coordinates when the file has them) of an
 /// OBJ file, at most `limit`, and the names of its `usemtl` statements.
+/// The line (from 1) of the first vertex statement `v x y z` of an OBJ's `text` whose
+/// coordinates are not all finite as the reader stores them (f32: `1e39` is infinite), so
+/// that the error names it in a file of a million lines.
+fn first_infinite_vertex(text: &str) -> Option<usize> {
+    text.lines().enumerate().find_map(|(i, l)| {
+        let mut words = l.split_whitespace();
+        (words.next() == Some("v")
+            && words
+                .take(3)
+                .any(|w| w.parse::<f32>().is_ok_and(|x| !x.is_finite())))
+        .then_some(i + 1)
+    })
+}
+
 fn load_obj(path: &Path, limit: usize) -> Result<Obj, String> {
     crate::error::regular_file(path)?;
     let opts = tobj::LoadOptions {
@@ -1301,11 +1315,17 @@ fn load_obj(path: &Path, limit: usize) -> Result<Obj, String> {
                 return Err(too_many_triangles());
             }
             // The reader checked every index against the file's vertices.
-            let bad = "a vertex (`v`) has a coordinate that is not a finite number";
+            let bad = || {
+                let what = "a vertex (`v`) has a coordinate that is not a finite number";
+                match first_infinite_vertex(&text) {
+                    Some(line) => format!("line {line}: {what}"),
+                    None => what.to_string(),
+                }
+            };
             let p = [
-                get(&mesh.positions, f[0]).ok_or(bad)?,
-                get(&mesh.positions, f[1]).ok_or(bad)?,
-                get(&mesh.positions, f[2]).ok_or(bad)?,
+                get(&mesh.positions, f[0]).ok_or_else(bad)?,
+                get(&mesh.positions, f[1]).ok_or_else(bad)?,
+                get(&mesh.positions, f[2]).ok_or_else(bad)?,
             ];
             let n = if mesh.normals.is_empty() {
                 None

@@ -487,8 +487,9 @@ fn a_syntax_error_says_what_it_found() {
 }
 
 /// OBJ files a new user brought: a byte-order mark and a Latin-1 comment are read past;
-/// a bad vertex, a face beyond the vertices, a NaN coordinate, faces of no area and a mesh
-/// scaled below the least size each say what is wrong, in one positioned line.
+/// a bad vertex, a face beyond the vertices, a NaN coordinate (with the OBJ's line), faces
+/// of no area and a mesh scaled below the least size each say what is wrong, in one
+/// positioned line.
 #[test]
 fn obj_files_say_what_is_wrong_with_them() {
     let dir = std::env::temp_dir().join(format!("covtrace-obj-test-{}", std::process::id()));
@@ -516,9 +517,9 @@ fn obj_files_say_what_is_wrong_with_them() {
         ),
         (
             "nan.obj",
-            b"v nan 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n".to_vec(),
+            b"# a NaN on the file's third line\nv 0 0 0\nv 1 nan 0\nv 0 1 0\nf 1 2 3\n".to_vec(),
             "",
-            "a coordinate that is not a finite number",
+            "line 3: a vertex (`v`) has a coordinate that is not a finite number",
         ),
         (
             "line.obj",
