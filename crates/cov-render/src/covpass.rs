@@ -20,8 +20,10 @@
 //!    outgoing ray; then the change of handedness and the texture), inside `Moving` when
 //!    the shape moves;
 //! 4. for a second vertex (`depth` 2; the renderer's default is [`DEFAULT_DEPTH`], one),
-//!    travel back along the path to the first and the reflection there, as in 3 (glossy
-//!    inter-reflection: a glossy floor mirroring what stands on it);
+//!    travel back along the path to the first, with a `BlockerEdge` where probes from the
+//!    first vertex at its lobe's angular width see an outline beside the segment, and the
+//!    reflection there, as in 3 (glossy inter-reflection: a glossy floor mirroring what
+//!    stands on it, the outline blurred by the floor's lobe);
 //! 5. travel to the camera, with a `Moving` `BlockerEdge` where auxiliary camera rays
 //!    around the pixel see a silhouette (a nearer surface or the background) in front of
 //!    or behind the hit, a crease or another material, its window weighed by the step's
@@ -397,9 +399,17 @@ pub fn trace_path<R: Rng>(
         // `v`, reflected there towards the vertex before, then what followed `v`.
         let d_in = -wi;
         let (x_in, x_next) = (frame_x(d_in, v.n), frame_x(d_in, next.n));
-        let mut t = Chain::new()
-            .with(Travel::new(next.t)?)
-            .with(RotateFrame::new(turn(d_in, x_next, x_in))?);
+        let mut t = Chain::new();
+        match segment_edge(world, (&v, &mat), wi, &next, time, fp.0) {
+            Some(e) => {
+                t.push(Travel::new((next.t - e.depth).max(0.0))?);
+                let edge = Chain::new().with(BlockerEdge::new(e.radius)?);
+                push_on(&mut t, motion, e.velocity, (d_in, x_next), edge)?;
+                t.push(Travel::new(e.depth.min(next.t))?);
+            }
+            None => t.push(Travel::new(next.t)?),
+        }
+        t.push(RotateFrame::new(turn(d_in, x_next, x_in))?);
         let here = at_surface(world, &v, &mat, (d_in, x_in, cos_i), (d_o, x_o), fp)?;
         push_on(&mut t, motion, v.velocity, (d_o, x_o), here)?;
         t.push(tail);
@@ -658,7 +668,8 @@ pub const CREASE_COS: f64 = 0.906;
 
 /// A silhouette near a pixel's path.
 struct Silhouette {
-    /// Distance from the camera to the edge's surface (m).
+    /// Distance from the probes' origin (the camera, or the vertex a segment leaves) to
+    /// the edge's surface (m).
     depth: f64,
     /// Distance from the path to the edge at that depth (m), divided by the square root of
     /// the edge's contrast ([`contrast`]): the `BlockerEdge` whose window is the contrast
@@ -817,6 +828,75 @@ fn nearest_silhouette(
         // Half a pixel's footprint at that depth, its window weighed by the contrast.
         let radius = (cam.tan_x * depth / cam.width as f64).max(1e-9) / c.sqrt();
         if best.as_ref().is_none_or(|b| radius < b.radius) {
+            best = Some(Silhouette {
+                depth,
+                radius,
+                velocity: vel,
+            });
+        }
+    }
+    best
+}
+
+/// An edge near the segment from the vertex `v` to the next vertex `next` (along `wi`):
+/// an outline in what a glossy `v` reflects (the floor mirroring a torus against the
+/// wall). Four probes from `v` at the lobe's angular std from the segment (`tan θ` the
+/// square root of the lobe's smaller primal variance), tested against `next` as the
+/// camera's probes are tested against the first hit ([`nearest_silhouette`]): another
+/// depth than `next`'s tangent plane, a crease, another material. The edge lies at the
+/// nearer surface's distance from `v`, `tan θ` times that distance from the segment, its
+/// window weighed by the step's [`contrast`]. A diffuse `v` (infinite variance) has none:
+/// its reflection removes every angular detail, so no edge beyond it reaches the image.
+fn segment_edge(
+    world: &World,
+    (v, mat): (&Hit, &crate::material::Material),
+    wi: DVec3,
+    next: &Hit,
+    time: f64,
+    footprint: f64,
+) -> Option<Silhouette> {
+    let (vu, vv) = mat.lobe().variances();
+    let tan = vu.min(vv).sqrt();
+    if !(tan.is_finite() && tan > 0.0) {
+        return None;
+    }
+    let (a, b) = wi.any_orthonormal_pair();
+    let origin = spawn(v, wi);
+    let mut best: Option<Silhouette> = None;
+    let mut here: Option<f64> = None;
+    for off in [a, -a, b, -b] {
+        let dir = (wi + off * tan).normalize();
+        if dir.dot(v.ng) <= 0.0 {
+            continue;
+        }
+        let h = world.geometry.intersect(origin, dir, time, 0.0, f64::INFINITY);
+        let along = next.n.dot(dir);
+        let on_plane = if along.abs() > 1e-12 {
+            (next.n.dot(next.p - origin) / along).max(0.0)
+        } else {
+            f64::INFINITY
+        };
+        let (depth, vel) = match h {
+            Some(h2)
+                if (h2.t - on_plane).abs() <= DEPTH_JUMP * next.t
+                    && h2.n.dot(next.n) >= CREASE_COS
+                    && same_surface(world, next, &h2) =>
+            {
+                continue;
+            }
+            Some(h2) => (
+                h2.t.min(next.t),
+                if h2.t < next.t { h2.velocity } else { next.velocity },
+            ),
+            None => (next.t, next.velocity),
+        };
+        let l_here = *here.get_or_insert_with(|| direct_proxy(world, Some(next), wi, footprint));
+        let c = contrast(l_here, direct_proxy(world, h.as_ref(), dir, footprint));
+        if c <= 0.0 {
+            continue;
+        }
+        let radius = (tan * depth).max(1e-9) / c.sqrt();
+        if best.as_ref().is_none_or(|e| radius < e.radius) {
             best = Some(Silhouette {
                 depth,
                 radius,
@@ -1040,4 +1120,82 @@ fn block_cov<R: Rng>(
         acc.spp = plain_spp / n_plain;
     }
     Ok(acc)
+}
+
+#[cfg(test)]
+mod tests {
+    use glam::DQuat;
+
+    use super::*;
+
+    /// A floor of `floor` (a material's RON) at y = 0, a ball of radius 0.5 standing at
+    /// 3 m, a wall at 6 m, lit from above.
+    fn floor_and_ball(floor: &str) -> World {
+        let text = format!(
+            r#"Scene(
+            camera: (position: (0.0, 1.0, 2.0), look_at: (0.0, 0.0, 0.0), fov: 40.0, width: 16, height: 16),
+            materials: {{ "floor": {floor}, "ball": Diffuse(albedo: (0.8, 0.2, 0.2)), "wall": Diffuse(albedo: (0.5, 0.5, 0.5)) }},
+            lights: [Sphere(center: (0.0, 4.0, -2.0), radius: 0.5, radiance: (5.0, 5.0, 5.0))],
+            shapes: [
+                Quad(corner: (-20.0, 0.0, 4.0), edge_u: (40.0, 0.0, 0.0), edge_v: (0.0, 0.0, -10.0), material: "floor"),
+                Quad(corner: (-20.0, 0.0, -6.0), edge_u: (40.0, 0.0, 0.0), edge_v: (0.0, 20.0, 0.0), material: "wall"),
+                Sphere(center: (0.0, 0.5, -3.0), radius: 0.5, material: "ball"),
+            ],
+        )"#
+        );
+        World::from_text(&text, "<test>", std::path::Path::new(".")).unwrap()
+    }
+
+    /// From the floor's point under the camera's gaze, the segment to the wall along
+    /// `wi`, turned `angle` radians sideways from the ball's centre.
+    fn segment(world: &World, angle: f64) -> (Hit, DVec3, Hit) {
+        let v = world
+            .geometry
+            .intersect(DVec3::new(0.0, 1.0, 0.0), DVec3::NEG_Y, 0.0, 0.0, 10.0)
+            .unwrap();
+        let to_ball = (DVec3::new(0.0, 0.5, -3.0) - v.p).normalize();
+        let wi = DQuat::from_rotation_y(angle) * to_ball;
+        let next = world
+            .geometry
+            .intersect(spawn(&v, wi), wi, 0.0, 0.0, f64::INFINITY)
+            .unwrap();
+        (v, wi, next)
+    }
+
+    /// A glossy floor mirrors the ball's outline against the wall: a segment that passes
+    /// the ball within the lobe's width (Phong 100: `tan θ` = 0.1) finds the outline at the
+    /// ball's distance, its window the lobe's width there weighed by the contrast; one
+    /// far from the ball finds none, and a diffuse floor, whose reflection keeps no
+    /// angular detail, never looks.
+    #[test]
+    fn a_glossy_floor_reflects_the_outline_beside_its_path() {
+        let glossy = floor_and_ball("Phong(albedo: (0.8, 0.8, 0.8), exponent: 100.0)");
+        let mat = |w: &World, v: &Hit| w.material_at(v, 1e-3);
+        // The ball subtends 0.165 rad from the floor's point; 0.2 rad sideways passes it
+        // by 0.035 rad, inside the lobe's 0.1.
+        let (v, wi, next) = segment(&glossy, 0.2);
+        assert!(next.t > 5.0, "the segment reaches the wall: {}", next.t);
+        let e = segment_edge(&glossy, (&v, &mat(&glossy, &v)), wi, &next, 0.0, 1e-3)
+            .expect("the ball's outline beside the segment");
+        assert!(
+            (2.4..3.1).contains(&e.depth),
+            "at the ball's distance: {}",
+            e.depth
+        );
+        // The lobe's width at the ball over the square root of the contrast (at most 1; the
+        // ball and the wall are both lit, well above a contrast of 1%).
+        let full = 0.1 * e.depth;
+        assert!(
+            e.radius >= full * (1.0 - 1e-9) && e.radius <= 10.0 * full,
+            "the lobe's width at the ball is {full} m, the edge's radius {}",
+            e.radius
+        );
+        // Far from the ball: the wall alone, one surface.
+        let (v, wi, next) = segment(&glossy, 0.7);
+        assert!(segment_edge(&glossy, (&v, &mat(&glossy, &v)), wi, &next, 0.0, 1e-3).is_none());
+        // A diffuse floor: no probe.
+        let dull = floor_and_ball("Diffuse(albedo: (0.8, 0.8, 0.8))");
+        let (v, wi, next) = segment(&dull, 0.2);
+        assert!(segment_edge(&dull, (&v, &mat(&dull, &v)), wi, &next, 0.0, 1e-3).is_none());
+    }
 }
