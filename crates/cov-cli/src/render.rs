@@ -378,7 +378,7 @@ pub fn bar(len: usize, what: &str) -> ProgressBar {
 pub fn load(scene: &Path, size: Option<(u32, u32)>) -> Result<World, String> {
     let world = World::load(scene).map_err(|e| e.to_string())?;
     for w in &world.warnings {
-        eprintln!("warning: {}: {w}", world.file);
+        eprintln!("warning: {w}");
     }
     Ok(match size {
         Some((w, h)) => world.with_resolution(w, h),

@@ -314,9 +314,9 @@ pub struct World {
     /// a time axis, layout 5; else layout 4).
     pub has_motion: bool,
     /// What the scene asks for that is read otherwise than its file may suggest, one line
-    /// each, for the user (an OBJ whose `usemtl` lines name several materials, which a
-    /// mesh does not read). The scene loads and renders; `covtrace` prints them as
-    /// warnings.
+    /// each, positioned as errors are (`file:line:col: message`), for the user (an OBJ
+    /// whose `usemtl` lines name several materials, which a mesh does not read). The
+    /// scene loads and renders; `covtrace` prints them as warnings.
     pub warnings: Vec<String>,
 }
 
@@ -472,6 +472,7 @@ impl World {
         .map_err(|(o, m)| at(o, m))?
             || camera.velocity != DVec3::ZERO;
         large_enough(&desc).map_err(|(o, m)| at(o, m))?;
+        let warnings = warnings.into_iter().map(|(o, m)| at(o, m).to_string()).collect();
         let inputs = input_files(&desc, dir);
         Ok(World {
             file: file.to_string(),
@@ -586,7 +587,8 @@ fn camera(c: &CameraDesc) -> Result<Camera, Failure> {
     };
     let (slo, shi) = crate::scene::SHUTTER_RANGE;
     let shutter = match &c.shutter {
-        Some(s) if s.close.value.0 > s.open.0 && !(slo..=shi).contains(&(s.close.value.0 - s.open.0)) => {
+        // Equal ends are a shutter open for no time, not one that closes first.
+        Some(s) if s.close.value.0 >= s.open.0 && !(slo..=shi).contains(&(s.close.value.0 - s.open.0)) => {
             return Err((
                 s.close.ordinal,
                 format!(
@@ -1115,7 +1117,7 @@ fn shapes(
     prims: &mut Vec<Prim>,
     (t0, t1): (f64, f64),
     boxes: &mut SharedBoxes,
-    warnings: &mut Vec<String>,
+    warnings: &mut Vec<Failure>,
 ) -> Result<bool, Failure> {
     let mut triangles = 0usize;
     let mut any_velocity = false;
@@ -1187,12 +1189,15 @@ fn shapes(
                         .map(|n| format!("`{}`", crate::echo(n)))
                         .collect();
                     let more = if usemtl.len() > 4 { ", …" } else { "" };
-                    warnings.push(format!(
-                        "OBJ `{}` names {} materials with `usemtl` ({}{more}); a mesh has one material, so all of it is `{}` (one OBJ file per material, one `Mesh` each, gives each its own)",
-                        crate::echo(&obj.value),
-                        usemtl.len(),
-                        listed.join(", "),
-                        crate::echo(&material.value)
+                    warnings.push((
+                        obj.ordinal,
+                        format!(
+                            "OBJ `{}` names {} materials with `usemtl` ({}{more}); a mesh has one material, so all of it is `{}` (one OBJ file per material, one `Mesh` each, gives each its own)",
+                            crate::echo(&obj.value),
+                            usemtl.len(),
+                            listed.join(", "),
+                            crate::echo(&material.value)
+                        ),
                     ));
                 }
                 if tris.len() > MAX_TRIANGLES - triangles {

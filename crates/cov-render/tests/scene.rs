@@ -51,7 +51,7 @@ fn error(text: &str) -> String {
 
 #[test]
 fn checks_after_parsing_point_at_the_value() {
-    let cases: [(&[(&str, &str)], &str); 13] = [
+    let cases: [(&[(&str, &str)], &str); 14] = [
         (
             &[("LOOK", "(0.0, 1.0, 3.0)")],
             "2:50: the camera looks at its own position",
@@ -78,6 +78,10 @@ fn checks_after_parsing_point_at_the_value() {
         (
             &[("LENS", ", shutter: (open: 0.5, close: 0.1)")],
             "2:127: the shutter closes (0.1) before it opens (0.5)",
+        ),
+        (
+            &[("LENS", ", shutter: (open: 0.25, close: 0.25)")],
+            "2:128: the shutter must stay open 1e-15 to",
         ),
         (
             &[("MAT", r#""hot": Diffuse(albedo: (2.0, 0.5, 0.5))"#)],
@@ -652,6 +656,8 @@ fn an_obj_of_several_materials_is_a_warning() {
     let w = world("two.obj");
     assert_eq!(w.warnings.len(), 1, "{:?}", w.warnings);
     let m = &w.warnings[0];
+    // Positioned at the mesh's OBJ, as an error would be.
+    assert!(m.starts_with("s.ron:5:85: OBJ"), "{m}");
     assert!(
         m.contains("OBJ `two.obj` names 2 materials with `usemtl` (`light`, `dark`)")
             && m.contains("all of it is `w`")
