@@ -734,6 +734,41 @@ fn same_surface(world: &World, a: &Hit, b: &Hit) -> bool {
             && world.material_textures.get(i) == world.material_textures.get(j))
 }
 
+/// What a probe from `origin` along `dir`, which met `h`, says about the surface of
+/// `hit` (met at distance `hit.t` from the same origin) beside it: `None` where that
+/// surface continues (the probe meets a surface within [`DEPTH_JUMP`] of `hit.t` of where
+/// it would meet `hit`'s tangent plane, turned by less than a crease, of the same
+/// material: a surface that continues smoothly is no silhouette however oblique, though at
+/// grazing angles its depth changes by more than `DEPTH_JUMP` within half a pixel); else
+/// an edge: the nearer surface's distance from `origin`, and its velocity.
+fn edge_beside(
+    world: &World,
+    hit: &Hit,
+    (origin, dir): (DVec3, DVec3),
+    h: Option<&Hit>,
+) -> Option<(f64, DVec3)> {
+    let along = hit.n.dot(dir);
+    let on_plane = if along.abs() > 1e-12 {
+        (hit.n.dot(hit.p - origin) / along).max(0.0)
+    } else {
+        f64::INFINITY
+    };
+    match h {
+        Some(h2)
+            if (h2.t - on_plane).abs() <= DEPTH_JUMP * hit.t
+                && h2.n.dot(hit.n) >= CREASE_COS
+                && same_surface(world, hit, h2) =>
+        {
+            None
+        }
+        Some(h2) => Some((
+            h2.t.min(hit.t),
+            if h2.t < hit.t { h2.velocity } else { hit.velocity },
+        )),
+        None => Some((hit.t, hit.velocity)),
+    }
+}
+
 /// An edge around the pixel: auxiliary pinhole rays half a pixel away from the path, and
 /// at the centres of the block's corner pixels, that see something else: a surface at a
 /// clearly different depth (more than [`DEPTH_JUMP`] of the hit's depth away from where
@@ -795,28 +830,8 @@ fn nearest_silhouette(
         let h = world
             .geometry
             .intersect(r.origin, r.dir, r.time, 0.0, f64::INFINITY);
-        // Where the probe would meet the hit's tangent plane: a surface that continues
-        // smoothly is no silhouette, however oblique (at grazing angles its depth changes
-        // by more than DEPTH_JUMP within half a pixel).
-        let along = hit.n.dot(r.dir);
-        let on_plane = if along.abs() > 1e-12 {
-            (hit.n.dot(hit.p - r.origin) / along).max(0.0)
-        } else {
-            f64::INFINITY
-        };
-        let (depth, vel) = match h {
-            Some(h2)
-                if (h2.t - on_plane).abs() <= DEPTH_JUMP * hit.t
-                    && h2.n.dot(hit.n) >= CREASE_COS
-                    && same_surface(world, hit, &h2) =>
-            {
-                continue;
-            }
-            Some(h2) => (
-                h2.t.min(hit.t),
-                if h2.t < hit.t { h2.velocity } else { hit.velocity },
-            ),
-            None => (hit.t, hit.velocity),
+        let Some((depth, vel)) = edge_beside(world, hit, (r.origin, r.dir), h.as_ref()) else {
+            continue;
         };
         // The path's own side, once, seen along the first probe that finds an edge (half a
         // pixel from the path's own ray).
@@ -843,7 +858,7 @@ fn nearest_silhouette(
 /// wall). Four probes from `v` at the lobe's angular std from the segment (`tan θ` the
 /// square root of the lobe's smaller primal variance), tested against `next` as the
 /// camera's probes are tested against the first hit ([`nearest_silhouette`]): another
-/// depth than `next`'s tangent plane, a crease, another material. The edge lies at the
+/// depth than `next`'s tangent plane, a crease, another material ([`edge_beside`]). The edge lies at the
 /// nearer surface's distance from `v`, `tan θ` times that distance from the segment, its
 /// window weighed by the step's [`contrast`]. A diffuse `v` (infinite variance) has none:
 /// its reflection removes every angular detail, so no edge beyond it reaches the image.
@@ -870,25 +885,8 @@ fn segment_edge(
             continue;
         }
         let h = world.geometry.intersect(origin, dir, time, 0.0, f64::INFINITY);
-        let along = next.n.dot(dir);
-        let on_plane = if along.abs() > 1e-12 {
-            (next.n.dot(next.p - origin) / along).max(0.0)
-        } else {
-            f64::INFINITY
-        };
-        let (depth, vel) = match h {
-            Some(h2)
-                if (h2.t - on_plane).abs() <= DEPTH_JUMP * next.t
-                    && h2.n.dot(next.n) >= CREASE_COS
-                    && same_surface(world, next, &h2) =>
-            {
-                continue;
-            }
-            Some(h2) => (
-                h2.t.min(next.t),
-                if h2.t < next.t { h2.velocity } else { next.velocity },
-            ),
-            None => (next.t, next.velocity),
+        let Some((depth, vel)) = edge_beside(world, next, (origin, dir), h.as_ref()) else {
+            continue;
         };
         let l_here = *here.get_or_insert_with(|| direct_proxy(world, Some(next), wi, footprint));
         let c = contrast(l_here, direct_proxy(world, h.as_ref(), dir, footprint));
