@@ -400,15 +400,8 @@ pub fn trace_path<R: Rng>(
         let d_in = -wi;
         let (x_in, x_next) = (frame_x(d_in, v.n), frame_x(d_in, next.n));
         let mut t = Chain::new();
-        match segment_edge(world, (&v, &mat), wi, &next, time, fp.0) {
-            Some(e) => {
-                t.push(Travel::new((next.t - e.depth).max(0.0))?);
-                let edge = Chain::new().with(BlockerEdge::new(e.radius)?);
-                push_on(&mut t, motion, e.velocity, (d_in, x_next), edge)?;
-                t.push(Travel::new(e.depth.min(next.t))?);
-            }
-            None => t.push(Travel::new(next.t)?),
-        }
+        let edge = segment_edge(world, (&v, &mat), wi, &next, time, fp.0);
+        travel_past(&mut t, next.t, edge, motion, (d_in, x_next))?;
         t.push(RotateFrame::new(turn(d_in, x_next, x_in))?);
         let here = at_surface(world, &v, &mat, (d_in, x_in, cos_i), (d_o, x_o), fp)?;
         push_on(&mut t, motion, v.velocity, (d_o, x_o), here)?;
@@ -541,15 +534,8 @@ fn camera_side(
     let x_out = frame_x(d_out, hit.n);
     let x_cam = frame_x(d_out, cam.right);
     let mut chain = Chain::new();
-    match nearest_silhouette(world, hit, (px, py), block, ut, footprint) {
-        Some(e) => {
-            chain.push(Travel::new((hit.t - e.depth).max(0.0))?);
-            let edge = Chain::new().with(BlockerEdge::new(e.radius)?);
-            push_on(&mut chain, motion, e.velocity, (d_out, x_out), edge)?;
-            chain.push(Travel::new(e.depth.min(hit.t))?);
-        }
-        None => chain.push(Travel::new(hit.t)?),
-    }
+    let edge = nearest_silhouette(world, hit, (px, py), block, ut, footprint);
+    travel_past(&mut chain, hit.t, edge, motion, (d_out, x_out))?;
     chain.push(RotateFrame::new(turn(d_out, x_out, x_cam))?);
     if motion && cam.velocity != DVec3::ZERO {
         chain.push(CameraMotion::new(
@@ -559,6 +545,28 @@ fn camera_side(
     }
     chain.push(cc.end.clone());
     Ok(chain)
+}
+
+/// Travel of `len` towards the probes' origin (the camera, or the vertex before), past
+/// `edge` where one was found: travel to it, its `BlockerEdge` (inside `Moving` when the
+/// nearer surface moves, in the frame `(x, d × x)` of the ray `d`), travel on.
+fn travel_past(
+    chain: &mut Chain,
+    len: f64,
+    edge: Option<Silhouette>,
+    motion: bool,
+    (d, x): (DVec3, DVec3),
+) -> Result<(), CovError> {
+    match edge {
+        Some(e) => {
+            chain.push(Travel::new((len - e.depth).max(0.0))?);
+            let window = Chain::new().with(BlockerEdge::new(e.radius)?);
+            push_on(chain, motion, e.velocity, (d, x), window)?;
+            chain.push(Travel::new(e.depth.min(len))?);
+        }
+        None => chain.push(Travel::new(len)?),
+    }
+    Ok(())
 }
 
 /// The nearest blocker edge near the path from the light point `y` to the hit, found by
