@@ -23,6 +23,11 @@ use rayon::prelude::*;
 /// in f32, times 4/3: about 0.7 GB at 4096²; a scene with one peaked at 0.71 GB resident).
 pub const MAX_TEXTURE_SIDE: u32 = 4096;
 
+/// Largest texture image file read (bytes): eight f32 channels at the largest side
+/// ([`MAX_TEXTURE_SIDE`]), 512 MiB. The file is hashed into the scene's fingerprint as
+/// well as decoded; a PNG padded past its end was read whole.
+pub const MAX_TEXTURE_BYTES: u64 = 512 << 20;
+
 /// One level of the pyramid.
 #[derive(Clone, Debug)]
 struct Level {
@@ -200,7 +205,7 @@ impl TextureMap {
     pub fn load(path: &Path, repeat: DVec2) -> Result<TextureMap, String> {
         let one = |e: &dyn std::fmt::Display| cov_core::one_line(&e.to_string());
         crate::error::regular_file(path)?;
-        let limit = crate::world::MAX_TEXTURE_BYTES;
+        let limit = MAX_TEXTURE_BYTES;
         let len = std::fs::metadata(path).map_err(|e| one(&e))?.len();
         if len > limit {
             return Err(format!(

@@ -673,10 +673,6 @@ pub const MAX_SCENE_TEXELS: usize = 2 * 4096 * 4096;
 /// 1e-10, or Phong of exponent 1e20, lost its lights' reflections without a word. 1e-6
 /// leaves a margin of about 70.
 pub const MIN_LOBE_WIDTH: f64 = 1e-6;
-/// Largest texture image file read (bytes): eight f32 channels at the largest side
-/// ([`crate::texture::MAX_TEXTURE_SIDE`]), 512 MiB. The file is hashed into the scene's
-/// fingerprint as well as decoded; a PNG padded past its end was read whole.
-pub const MAX_TEXTURE_BYTES: u64 = 512 << 20;
 /// Largest OBJ file read (bytes): about 70 bytes a triangle for [`MAX_TRIANGLES`].
 pub const MAX_OBJ_BYTES: u64 = 350 << 20;
 

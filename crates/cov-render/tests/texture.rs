@@ -100,7 +100,7 @@ fn a_padded_texture_file_is_refused_unread() {
         .write(true)
         .open(dir.join("pad.png"))
         .unwrap();
-    f.set_len(cov_render::world::MAX_TEXTURE_BYTES + 1).unwrap();
+    f.set_len(cov_render::texture::MAX_TEXTURE_BYTES + 1).unwrap();
     let text = board(0.25, 8, 8).replace(
         "Checker(checks: (4, 4), a: (0.8, 0.8, 0.8), b: (0.1, 0.1, 0.1), size: 512)",
         "Image(file: \"pad.png\")",
@@ -111,8 +111,8 @@ fn a_padded_texture_file_is_refused_unread() {
         e,
         format!(
             "s.ron:3:42: texture `board`: the file is {} bytes; texture files are read up to {} bytes",
-            cov_render::world::MAX_TEXTURE_BYTES + 1,
-            cov_render::world::MAX_TEXTURE_BYTES
+            cov_render::texture::MAX_TEXTURE_BYTES + 1,
+            cov_render::texture::MAX_TEXTURE_BYTES
         )
     );
 }
