@@ -742,6 +742,14 @@ fn same_surface(world: &World, a: &Hit, b: &Hit) -> bool {
             && world.material_textures.get(i) == world.material_textures.get(j))
 }
 
+/// `edge` in `best` if it is the first found or narrower than the one there: the
+/// sharpest edge's window wins.
+fn keep_narrowest(best: &mut Option<Silhouette>, edge: Silhouette) {
+    if best.as_ref().is_none_or(|b| edge.radius < b.radius) {
+        *best = Some(edge);
+    }
+}
+
 /// What a probe from `origin` along `dir`, which met `h`, says about the surface of
 /// `hit` (met at distance `hit.t` from the same origin) beside it: `None` where that
 /// surface continues (the probe meets a surface within [`DEPTH_JUMP`] of `hit.t` of where
@@ -850,13 +858,14 @@ fn nearest_silhouette(
         }
         // Half a pixel's footprint at that depth, its window weighed by the contrast.
         let radius = (cam.tan_x * depth / cam.width as f64).max(1e-9) / c.sqrt();
-        if best.as_ref().is_none_or(|b| radius < b.radius) {
-            best = Some(Silhouette {
+        keep_narrowest(
+            &mut best,
+            Silhouette {
                 depth,
                 radius,
                 velocity: vel,
-            });
-        }
+            },
+        );
     }
     best
 }
@@ -902,13 +911,14 @@ fn segment_edge(
             continue;
         }
         let radius = (tan * depth).max(1e-9) / c.sqrt();
-        if best.as_ref().is_none_or(|e| radius < e.radius) {
-            best = Some(Silhouette {
+        keep_narrowest(
+            &mut best,
+            Silhouette {
                 depth,
                 radius,
                 velocity: vel,
-            });
-        }
+            },
+        );
     }
     best
 }

@@ -108,3 +108,18 @@ pub(crate) fn regular_file(path: &std::path::Path) -> Result<(), String> {
         Err(e) => Err(format!("{}: {}", shown(), cov_core::one_line(&e.to_string()))),
     }
 }
+
+/// `Ok` if the file at `path`, a `what` file (scene, OBJ, texture), is at most `limit`
+/// bytes long by its length; otherwise one line saying so. A device or a pipe reports no
+/// length: a reader that reads it must stop past `limit` itself (as `read_bounded` in world.rs does).
+pub(crate) fn within_length(path: &std::path::Path, limit: u64, what: &str) -> Result<(), String> {
+    let len = std::fs::metadata(path)
+        .map_err(|e| cov_core::one_line(&e.to_string()))?
+        .len();
+    if len > limit {
+        return Err(format!(
+            "the file is {len} bytes; {what} files are read up to {limit} bytes"
+        ));
+    }
+    Ok(())
+}

@@ -205,13 +205,7 @@ impl TextureMap {
     pub fn load(path: &Path, repeat: DVec2) -> Result<TextureMap, String> {
         let one = |e: &dyn std::fmt::Display| cov_core::one_line(&e.to_string());
         crate::error::regular_file(path)?;
-        let limit = MAX_TEXTURE_BYTES;
-        let len = std::fs::metadata(path).map_err(|e| one(&e))?.len();
-        if len > limit {
-            return Err(format!(
-                "the file is {len} bytes; texture files are read up to {limit} bytes"
-            ));
-        }
+        crate::error::within_length(path, MAX_TEXTURE_BYTES, "texture")?;
         // By content, then by extension; anything but PNG and EXR is named as such.
         let open = || {
             let r = image::ImageReader::open(path)

@@ -673,6 +673,8 @@ pub const MAX_SCENE_TEXELS: usize = 2 * 4096 * 4096;
 /// 1e-10, or Phong of exponent 1e20, lost its lights' reflections without a word. 1e-6
 /// leaves a margin of about 70.
 pub const MIN_LOBE_WIDTH: f64 = 1e-6;
+/// Largest Phong exponent: a lobe of angular std [`MIN_LOBE_WIDTH`] (`1/√e`), 1e12.
+pub const MAX_PHONG_EXPONENT: f64 = 1.0 / (MIN_LOBE_WIDTH * MIN_LOBE_WIDTH);
 /// Largest OBJ file read (bytes): about 70 bytes a triangle for [`MAX_TRIANGLES`].
 pub const MAX_OBJ_BYTES: u64 = 350 << 20;
 
@@ -701,12 +703,7 @@ fn too_many_texels(texels: usize, name: &At<String>, at: u32, made: bool) -> Res
 /// An unreadable file, or one longer than `limit`, in one line.
 pub fn read_bounded(path: &Path, limit: u64, what: &str) -> Result<Vec<u8>, String> {
     use std::io::Read;
-    let len = std::fs::metadata(path).map_err(|e| e.to_string())?.len();
-    if len > limit {
-        return Err(format!(
-            "the file is {len} bytes; {what} files are read up to {limit} bytes"
-        ));
-    }
+    crate::error::within_length(path, limit, what)?;
     let mut bytes = Vec::new();
     std::fs::File::open(path)
         .and_then(|f| f.take(limit + 1).read_to_end(&mut bytes))
@@ -867,13 +864,10 @@ fn materials(desc: &SceneFile, textures: &Names<'_>) -> Result<Materials, Failur
                 "alpha {} is below {MIN_LOBE_WIDTH:e}",
                 cov_core::num(alpha)
             )),
-            Material::Phong { exponent, .. } if exponent > 1.0 / (MIN_LOBE_WIDTH * MIN_LOBE_WIDTH) => {
-                Some(format!(
-                    "exponent {} is above {:e}",
-                    cov_core::num(exponent),
-                    1.0 / (MIN_LOBE_WIDTH * MIN_LOBE_WIDTH)
-                ))
-            }
+            Material::Phong { exponent, .. } if exponent > MAX_PHONG_EXPONENT => Some(format!(
+                "exponent {} is above {MAX_PHONG_EXPONENT:e}",
+                cov_core::num(exponent)
+            )),
             _ => None,
         };
         if let Some(what) = narrow {
@@ -1268,8 +1262,6 @@ fn too_many_triangles() -> String {
     format!("more than {MAX_TRIANGLES} triangles in the scene; meshes are read up to that")
 }
 
-/// Triangles (with vertex normals and texture coordinates when the file has them) of an
-/// OBJ file, at most `limit`, and the names of its `usemtl` statements.
 /// The line (from 1) of the first vertex statement `v x y z` of an OBJ's `text` whose
 /// coordinates are not all finite as the reader stores them (f32: `1e39` is infinite), so
 /// that the error names it in a file of a million lines.
@@ -1284,6 +1276,8 @@ fn first_infinite_vertex(text: &str) -> Option<usize> {
     })
 }
 
+/// Triangles (with vertex normals and texture coordinates when the file has them) of an
+/// OBJ file, at most `limit`, and the names of its `usemtl` statements.
 fn load_obj(path: &Path, limit: usize) -> Result<Obj, String> {
     crate::error::regular_file(path)?;
     let opts = tobj::LoadOptions {
