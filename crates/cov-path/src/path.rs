@@ -111,22 +111,15 @@ fn explain(
             ),
         );
     }
-    if rest == "Expected comma" || matches!(code, ron::Error::ExpectedComma) {
-        let at: String = text
-            .lines()
-            .nth(line.saturating_sub(1))
-            .unwrap_or("")
-            .chars()
-            .skip(col.saturating_sub(1))
-            .take(2)
-            .collect();
-        if at.starts_with('.') || at.starts_with(['e', 'E']) {
-            return (
-                line,
-                col,
-                format!("{prefix}expected a whole number here, found a decimal number"),
-            );
-        }
+    if decimal_for_whole(&rest, text, line, col) {
+        let message = match crate::scan::field_at(text, line, col) {
+            Some((name, _, value)) => format!(
+                "{prefix}parameter `{name}` = {}: expected a whole number, found a decimal number",
+                cov_core::echo(&value)
+            ),
+            None => format!("{prefix}expected a whole number here, found a decimal number"),
+        };
+        return (line, col, message);
     }
     // `parameter `name``: point at the parameter where it is written.
     if let Some(tail) = rest.split("parameter `").nth(1)
@@ -169,6 +162,32 @@ fn wrong_type(
         (w, None) => format!("parameter `{name}` = {value}: expected {w}"),
     };
     Some((l, c, format!("{prefix}{message}")))
+}
+
+/// Whether ron's message `ron_message` at `(line, col)` of `text` (1-based, as ron
+/// reports it) is a decimal number where a whole number belongs: ron reads the digits
+/// before the `.` or the exponent's `e` as the whole number and then stops there, saying
+/// it expected a comma at the `.` (`128.0`), or, at the number's start, that `e` is no
+/// digit (`9e1`).
+pub fn decimal_for_whole(ron_message: &str, text: &str, line: usize, col: usize) -> bool {
+    let Some(row) = text.lines().nth(line.saturating_sub(1)) else {
+        return false;
+    };
+    let chars: Vec<char> = row.chars().collect();
+    let at = col.saturating_sub(1);
+    if ron_message == "Expected comma" {
+        let digit_before = at > 0 && chars.get(at - 1).is_some_and(|c| c.is_ascii_digit());
+        return digit_before && matches!(chars.get(at), Some('.' | 'e' | 'E'));
+    }
+    if ron_message.starts_with("Invalid digit ") {
+        let number: String = chars
+            .iter()
+            .skip(at)
+            .take_while(|c| c.is_ascii_alphanumeric() || matches!(c, '.' | '+' | '-' | '_'))
+            .collect();
+        return number.contains(['.', 'e', 'E']) && number.replace('_', "").parse::<f64>().is_ok();
+    }
+    false
 }
 
 /// What is wrong with a number written in another base (`0x10`, `0b1`, `0o7`, signed or

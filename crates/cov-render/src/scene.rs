@@ -576,6 +576,13 @@ impl SceneFile {
                 && let Some(words) = cov_path::not_decimal(&value)
             {
                 message = format!("`{name}` = {}: {words}", cov_core::echo(&value));
+            } else if cov_path::decimal_for_whole(&message, text, line, col)
+                && let Some((name, _, value)) = field()
+            {
+                message = format!(
+                    "`{name}` = {}: expected a whole number, found a decimal number",
+                    cov_core::echo(&value)
+                );
             } else if let ron::Error::Message(m) = &e.code
                 && let Some((name, ..)) = field()
             {

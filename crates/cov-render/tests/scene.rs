@@ -488,6 +488,17 @@ fn a_syntax_error_says_what_it_found() {
     assert!(e.ends_with("`fov` = \"wide\": expected a number"), "{e}");
     let e = error(&scene(&[("FOV", "true")]));
     assert!(e.ends_with("`fov` = true: expected a number"), "{e}");
+    // A decimal number where a whole number belongs: ron stops at its `.` or at its `e`.
+    let e = error(&scene(&[("width: 8", "width: 8.0")]));
+    assert!(
+        e.ends_with("`width` = 8.0: expected a whole number, found a decimal number"),
+        "{e}"
+    );
+    let e = error(&scene(&[("height: 8", "height: 8e0")]));
+    assert!(
+        e.ends_with("`height` = 8e0: expected a whole number, found a decimal number"),
+        "{e}"
+    );
 }
 
 /// OBJ files a new user brought: a byte-order mark and a Latin-1 comment are read past;
