@@ -258,6 +258,64 @@ pub fn field_at(text: &str, line: usize, col: usize) -> Option<(String, (usize, 
     Some((name, pos[start], value))
 }
 
+/// A field as [`field_at`] finds it: its name, the name's position (line, column, 1-based)
+/// and its value as written.
+pub type Field = (String, (usize, usize), String);
+
+/// The tuple element ron stopped at in RON `text`, `(line, col)` (1-based) being in it
+/// or just before it (`(0.0, "a", 1.3)` refused at `"a"`, or at a fourth value): the
+/// field the tuple is the value of (as [`field_at`] gives it: name, name's position,
+/// the tuple as written), the element's index from 0, and the element as written (at
+/// most 40 characters). `None` outside a tuple in parentheses, or for a tuple that is no
+/// field's value.
+pub fn element_at(text: &str, line: usize, col: usize) -> Option<(Field, usize, String)> {
+    let text = text.strip_prefix('\u{feff}').unwrap_or(text);
+    let written: Vec<char> = text.chars().collect();
+    let chars = code_of(&written);
+    let pos = char_positions(&chars);
+    let at = pos.iter().position(|&p| p >= (line, col)).unwrap_or(chars.len());
+    let (mut depth, mut index, mut i) = (0usize, 0usize, at);
+    let open = loop {
+        if i == 0 {
+            return None;
+        }
+        i -= 1;
+        match chars[i] {
+            ')' | ']' | '}' => depth += 1,
+            '(' if depth == 0 => break i,
+            '[' | '{' if depth == 0 => return None,
+            '(' | '[' | '{' => depth -= 1,
+            ',' if depth == 0 => index += 1,
+            _ => {}
+        }
+    };
+    let (l, c) = pos[open];
+    let field = field_at(text, l, c)?;
+    // The element: from `at` (skipping blanks) to the comma or bracket that ends it.
+    let mut v = at;
+    while v < chars.len() && chars[v].is_whitespace() {
+        v += 1;
+    }
+    let (mut depth, mut w) = (0usize, v);
+    while w < chars.len() {
+        match chars[w] {
+            '(' | '[' | '{' => depth += 1,
+            ')' | ']' | '}' if depth == 0 => break,
+            ')' | ']' | '}' => depth -= 1,
+            ',' | '\n' if depth == 0 => break,
+            _ => {}
+        }
+        w += 1;
+    }
+    let element: String = written[v..w]
+        .iter()
+        .take(40)
+        .collect::<String>()
+        .trim_end()
+        .to_string();
+    Some((field, index, element))
+}
+
 /// The first whitespace character other than an ASCII space, tab or line break (a
 /// no-break space U+00A0, an em space, an ideographic space…) outside comments and strings,
 /// before `(line, col)` or in the whitespace just after it: RON does not read it as space, and reports whatever it

@@ -553,6 +553,47 @@ fn found_at(text: &str, line: usize, col: usize) -> String {
     format!("`{token}`")
 }
 
+/// ron's message `message` at `(line, col)` of `text` said of a tuple's field, when it
+/// is about the tuple: its number of values (`position: (0.0, 0.8)`), a value of the wrong
+/// type in it (`radiance: (10.0, nan, 9.0)`), or one value too many. `None` otherwise.
+fn tuple_words(text: &str, line: usize, col: usize, message: &str) -> Option<String> {
+    if let Some(rest) = message.strip_prefix("Expected a tuple of size ")
+        && let Some((want, found)) = rest.split_once(" but found ")
+        && let Some((name, _, value)) = cov_path::field_at(text, line, col)
+    {
+        let found = found.split(' ').next().unwrap_or("");
+        return Some(format!(
+            "`{name}` = {}: expected {want} values, found {found}",
+            cov_core::echo(&value)
+        ));
+    }
+    let ((name, _, _), index, element) = cov_path::element_at(text, line, col)?;
+    let element = cov_core::echo(&element);
+    if message.starts_with("Expected closing `)`") {
+        // One value too many follows a comma; after a value, a comma is missing.
+        let before = text
+            .lines()
+            .take(line.saturating_sub(1))
+            .flat_map(|l| l.chars().chain(['\n']))
+            .chain(
+                text.lines()
+                    .nth(line.saturating_sub(1))
+                    .unwrap_or("")
+                    .chars()
+                    .take(col.saturating_sub(1)),
+            )
+            .filter(|c| !c.is_whitespace())
+            .last();
+        return (before == Some(','))
+            .then(|| format!("`{name}` has more than {index} values (found `{element}`)"));
+    }
+    let what = cov_path::expected_value(message, &element)?;
+    Some(format!(
+        "`{name}`: value {} = {element}: expected {what}",
+        index + 1
+    ))
+}
+
 impl SceneFile {
     /// Parses scene text; `file` names it in errors.
     ///
@@ -601,6 +642,8 @@ impl SceneFile {
                 } else {
                     format!("`{name}` = {value}: expected {what}")
                 };
+            } else if let Some(words) = tuple_words(text, line, col, &message) {
+                message = words;
             } else if message.starts_with("Expected") && !message.contains(" found ") {
                 // A syntax error: say what stands where something else was expected.
                 message = format!("{message}, found {}", found_at(text, line, col));

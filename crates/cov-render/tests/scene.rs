@@ -499,6 +499,25 @@ fn a_syntax_error_says_what_it_found() {
         e.ends_with("`height` = 8e0: expected a whole number, found a decimal number"),
         "{e}"
     );
+    // A tuple's values: how many, which one has the wrong type, one too many; a comma
+    // missing between two values stays a syntax error.
+    let e = error(&scene(&[("LOOK", "(0.0, 1.0)")]));
+    assert!(
+        e.ends_with("`look_at` = (0.0, 1.0): expected 3 values, found 2"),
+        "{e}"
+    );
+    let e = error(&scene(&[("LOOK", "(0.0, nan, 0.0)")]));
+    assert!(
+        e.ends_with("`look_at`: value 2 = nan: expected a finite number, not NaN"),
+        "{e}"
+    );
+    let e = error(&scene(&[("LOOK", "(0.0, 1.0, 0.0, 2.0)")]));
+    assert!(
+        e.ends_with("`look_at` has more than 3 values (found `2.0`)"),
+        "{e}"
+    );
+    let e = error(&scene(&[("LOOK", "(0.0, 1.0 0.0)")]));
+    assert!(e.ends_with("Expected comma, found `0.0`"), "{e}");
 }
 
 /// OBJ files a new user brought: a byte-order mark and a Latin-1 comment are read past;
