@@ -1295,7 +1295,12 @@ fn load_obj(path: &Path, limit: usize) -> Result<Obj, String> {
     // device or a pipe).
     let no_materials = |_: &Path| Ok((Vec::new(), Default::default()));
     let (models, _materials) =
-        tobj::load_obj_buf(&mut text.as_bytes(), &opts, no_materials).map_err(obj_error)?;
+        tobj::load_obj_buf(&mut text.as_bytes(), &opts, no_materials).map_err(|e| {
+            match obj_error_line(&text, e, &opts) {
+                Some(line) => format!("line {line}: {}", obj_error(e)),
+                None => obj_error(e),
+            }
+        })?;
     let mut out = Vec::new();
     for m in &models {
         let mesh = &m.mesh;
@@ -1381,6 +1386,90 @@ fn load_obj(path: &Path, limit: usize) -> Result<Obj, String> {
         triangles: out,
         usemtl,
     })
+}
+
+/// The line (from 1) of the first statement of an OBJ's `text` that the reader refuses
+/// with `e` (the reader does not give its line), or `None`.
+///
+/// - A statement refused for its own text (a vertex, normal, texture coordinate or face
+///   that does not parse, a weight of 0): the first statement of that kind that the
+///   reader, given that line alone with the same `opts`, refuses with the same error.
+/// - A face that refers to an element the file does not have: the first face with an
+///   index beyond the vertices, texture coordinates or normals stated before it
+///   (positive indices count from 1, negative ones back from the last).
+fn obj_error_line(text: &str, e: tobj::LoadError, opts: &tobj::LoadOptions) -> Option<usize> {
+    use tobj::LoadError as E;
+    let no_materials = |_: &Path| Ok((Vec::new(), Default::default()));
+    let alone = |line: &str| tobj::load_obj_buf(&mut line.as_bytes(), opts, no_materials).err() == Some(e);
+    let keyword = match e {
+        E::PositionParseError | E::ScalingByZeroError => "v",
+        E::NormalParseError => "vn",
+        E::TexcoordParseError => "vt",
+        E::FaceParseError => "f",
+        E::FaceVertexOutOfBounds | E::FaceTexCoordOutOfBounds | E::FaceNormalOutOfBounds => "",
+        _ => return None,
+    };
+    if !keyword.is_empty() {
+        return text
+            .lines()
+            .enumerate()
+            .find_map(|(i, l)| (l.split_whitespace().next() == Some(keyword) && alone(l)).then_some(i + 1));
+    }
+    // Which part of a face's `v/vt/vn` entries is out of bounds. The reader resolves a
+    // negative index against the elements stated so far and checks the result when it
+    // closes the object (at the next `o` or `g` statement, or the file's end), against the
+    // elements stated by then; an index that resolves to −1 is "none" for `vt` and `vn`.
+    let part = match e {
+        E::FaceVertexOutOfBounds => 0,
+        E::FaceTexCoordOutOfBounds => 1,
+        _ => 2,
+    };
+    let first = |l: &str| l.split_whitespace().next().map(str::to_owned);
+    let kind = |w: Option<&str>| match w {
+        Some("v") => Some(0),
+        Some("vt") => Some(1),
+        Some("vn") => Some(2),
+        _ => None,
+    };
+    // The count of the part's elements when each line's object closes: `before[i]` of
+    // the lines before line `i`, and the count before the next `o` or `g` line.
+    let lines: Vec<&str> = text.lines().collect();
+    let mut before = Vec::with_capacity(lines.len() + 1);
+    before.push(0i64);
+    for l in &lines {
+        let n = before.last().copied().unwrap_or(0);
+        before.push(n + i64::from(kind(first(l).as_deref()) == Some(part)));
+    }
+    let mut at_close = vec![0i64; lines.len()];
+    let mut close = before[lines.len()];
+    for (i, l) in lines.iter().enumerate().rev() {
+        if matches!(first(l).as_deref(), Some("o" | "g")) {
+            close = before[i];
+        }
+        at_close[i] = close;
+    }
+    let mut so_far = 0i64;
+    for (i, l) in lines.iter().enumerate() {
+        let mut words = l.split_whitespace();
+        match words.next() {
+            w if kind(w) == Some(part) => so_far += 1,
+            Some("f") => {
+                let beyond = words.any(|w| {
+                    let Some(k) = w.split('/').nth(part).and_then(|t| t.parse::<i64>().ok()) else {
+                        return false;
+                    };
+                    let resolved = if k < 0 { so_far + k } else { k - 1 };
+                    let none = part > 0 && resolved == -1;
+                    !none && (resolved < 0 || resolved >= at_close[i])
+                });
+                if beyond {
+                    return Some(i + 1);
+                }
+            }
+            _ => {}
+        }
+    }
+    None
 }
 
 /// The reader's error in words that say which statement of the file is wrong (the reader

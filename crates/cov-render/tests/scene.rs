@@ -521,7 +521,8 @@ fn a_syntax_error_says_what_it_found() {
 }
 
 /// OBJ files a new user brought: a byte-order mark and a Latin-1 comment are read past;
-/// a bad vertex, a face beyond the vertices, a NaN coordinate (with the OBJ's line), faces
+/// a bad vertex, a bad face, a face beyond the vertices or the normals stated before it,
+/// a NaN coordinate (each with the OBJ's line), faces
 /// of no area and a mesh scaled below the least size each say what is wrong, in one
 /// positioned line.
 #[test]
@@ -529,7 +530,7 @@ fn obj_files_say_what_is_wrong_with_them() {
     let dir = std::env::temp_dir().join(format!("covtrace-obj-test-{}", std::process::id()));
     std::fs::create_dir_all(&dir).expect("temp dir");
     let tri = "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n";
-    let cases: [(&str, Vec<u8>, &str, &str); 7] = [
+    let cases: [(&str, Vec<u8>, &str, &str); 11] = [
         ("bom.obj", [&b"\xef\xbb\xbf"[..], tri.as_bytes()].concat(), "", ""),
         (
             "latin1.obj",
@@ -541,13 +542,43 @@ fn obj_files_say_what_is_wrong_with_them() {
             "badnum.obj",
             b"v 1 abc 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n".to_vec(),
             "",
-            "a vertex (`v`) whose coordinates are not",
+            "line 1: a vertex (`v`) whose coordinates are not",
         ),
         (
             "oob.obj",
             b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 7\n".to_vec(),
             "",
-            "refers to a vertex (`v`) the file does not have",
+            "line 4: a face (`f`) refers to a vertex (`v`) the file does not have",
+        ),
+        (
+            "badface.obj",
+            [tri.as_bytes(), b"f 1 2 x\n"].concat(),
+            "",
+            "line 5: a face (`f`) whose entries are not",
+        ),
+        (
+            "normal.obj",
+            [
+                tri.as_bytes(),
+                b"vn 0 0 1\nf 1//1 2//1 3//1\nf -1//1 -2//2 -3//1\n",
+            ]
+            .concat(),
+            "",
+            "line 7: a face (`f`) refers to a normal (`vn`) the file does not have",
+        ),
+        // The reader checks an object's indices when it closes the object: a vertex
+        // stated later in the same object counts, one stated in the next does not.
+        (
+            "forward.obj",
+            b"v 0 0 0\nv 1 0 0\nf 1 2 3\nv 0 1 0\n".to_vec(),
+            "",
+            "",
+        ),
+        (
+            "closed.obj",
+            b"v 0 0 0\nv 1 0 0\no a\nf 1 2 3\no b\nv 0 1 0\nf 1 2 3\n".to_vec(),
+            "",
+            "line 4: a face (`f`) refers to a vertex (`v`)",
         ),
         (
             "nan.obj",
