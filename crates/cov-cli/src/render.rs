@@ -415,13 +415,37 @@ pub fn run(a: &RenderArgs) -> Result<String, String> {
     })?;
     match (a.frame, a.frames) {
         (_, Some((first, last))) => {
-            // Every frame checked before any is rendered (the two ends bound the rest).
-            for k in [first, last] {
-                if let Some(expected) = world.frame_problem(k) {
-                    return Err(format!(
-                        "--frames {first}..{last}: frame {k} is out of range: must be {expected}"
-                    ));
+            // Every frame checked before any is rendered. Motion is linear in time, so a
+            // shape's distance from the origin is convex in it: with the first frame in
+            // range, the frames out of range are those from the first one out to the last,
+            // found by bisection.
+            if let Some(expected) = world.frame_problem(first) {
+                return Err(format!(
+                    "--frames {first}..{last}: frame {first} is out of range: must be {expected}"
+                ));
+            }
+            if world.frame_problem(last).is_some() {
+                let (mut ok, mut bad) = (first, last);
+                while bad - ok > 1 {
+                    let mid = ok + (bad - ok) / 2;
+                    if world.frame_problem(mid).is_some() {
+                        bad = mid;
+                    } else {
+                        ok = mid;
+                    }
                 }
+                let expected = world
+                    .frame_problem(bad)
+                    .unwrap_or_default()
+                    .replace("this one", &format!("frame {bad}"));
+                let which = if bad == last {
+                    format!("frame {last} is")
+                } else {
+                    format!("frames {bad} to {last} are")
+                };
+                return Err(format!(
+                    "--frames {first}..{last}: {which} out of range: must be {expected}"
+                ));
             }
             // One scene, retimed for each frame; each frame's report printed as it is
             // done, the last one returned.

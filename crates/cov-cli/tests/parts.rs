@@ -196,7 +196,8 @@ fn frames_write_one_file_each_and_differ() {
 }
 
 /// `--frames` checks every frame before it renders the first: a range whose last frame
-/// carries a ball beyond the coordinate limit renders nothing and says which frame.
+/// carries a ball beyond the coordinate limit renders nothing and says which frames, from
+/// the first out of range.
 #[test]
 fn frames_are_checked_before_any_is_rendered() {
     let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
@@ -217,5 +218,13 @@ fn frames_are_checked_before_any_is_rendered() {
     assert!(
         !cov_cli::render::frame_path(&out_file, 0).exists(),
         "no frame was rendered"
+    );
+    // A longer range names the first frame out of range, not the last.
+    let out = render_frames(s(&scene), "0..9", &out_file);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("--frames 0..9: frames 2 to 9 are out of range: must be a frame at which every shape and the camera stay within")
+            && err.contains("(frame 2 moves one to"),
+        "{err}"
     );
 }
