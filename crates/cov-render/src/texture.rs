@@ -246,8 +246,23 @@ impl TextureMap {
             Ok(img) => img.into_rgb32f(),
             // An EXR of one grey channel `Y`, which the image library does not decode.
             Err(e) if exr => {
-                let grey = grey_exr(path)
-                    .ok_or_else(|| format!("{} (an EXR texture needs R, G and B channels, or Y)", one(&e)))?;
+                let grey = grey_exr(path).ok_or_else(|| match exr_channels(path) {
+                    // The channels are there: the data is what the decoder refused (a
+                    // file cut short, a damaged block).
+                    Some(c) if has_colour(&c) => {
+                        format!("{} (the file may be cut short or damaged)", one(&e))
+                    }
+                    Some(c) => format!(
+                        "{} (an EXR texture needs R, G and B channels, or Y; this one has {})",
+                        one(&e),
+                        if c.is_empty() {
+                            "none".to_string()
+                        } else {
+                            c.join(", ")
+                        }
+                    ),
+                    None => one(&e),
+                })?;
                 return Self::from_rgb(w, h, grey, repeat);
             }
             Err(e) => return Err(one(&e)),
@@ -383,6 +398,20 @@ impl TextureMap {
             }
         })
     }
+}
+
+/// The channel names of an EXR's first layer, from its header alone; `None` when the
+/// header cannot be read.
+fn exr_channels(path: &Path) -> Option<Vec<String>> {
+    let meta = exr::meta::MetaData::read_from_file(path, false).ok()?;
+    let header = meta.headers.first()?;
+    Some(header.channels.list.iter().map(|c| c.name.to_string()).collect())
+}
+
+/// Whether `channels` hold what a texture reads: R, G and B, or Y.
+fn has_colour(channels: &[String]) -> bool {
+    let has = |n: &str| channels.iter().any(|c| c == n);
+    (has("R") && has("G") && has("B")) || has("Y")
 }
 
 /// The texels of an EXR file's first layer as grey colours, where it has a channel `Y`
@@ -750,6 +779,30 @@ mod tests {
         assert_eq!(t.size(), (4, 2));
         assert_eq!(t.rgb(DVec2::new(0.375, 0.75), 0.0), DVec3::splat(0.75));
         assert_eq!(t.rgb(DVec2::new(0.375, 0.25), 0.0), DVec3::splat(0.25));
+        // An EXR of other channels names them; one cut short is not said to lack channels.
+        let depth = dir.join("z.exr");
+        let layer = Layer::new(
+            (w, h),
+            LayerAttributes::named(""),
+            Encoding::FAST_LOSSLESS,
+            SpecificChannels::build()
+                .with_channel("Z")
+                .with_pixel_fn(|_: Vec2<usize>| (1.0f32,)),
+        );
+        Image::from_layer(layer)
+            .write()
+            .to_file(&depth)
+            .expect("write EXR");
+        let e = TextureMap::load(&depth, DVec2::ONE).unwrap_err();
+        assert!(
+            e.ends_with("(an EXR texture needs R, G and B channels, or Y; this one has Z)"),
+            "{e}"
+        );
+        let bytes = std::fs::read(&path).expect("read EXR");
+        let cut = dir.join("cut.exr");
+        std::fs::write(&cut, &bytes[..bytes.len() - 8]).expect("write EXR");
+        let e = TextureMap::load(&cut, DVec2::ONE).unwrap_err();
+        assert!(e.ends_with("(the file may be cut short or damaged)"), "{e}");
         std::fs::remove_dir_all(&dir).expect("clean up");
     }
 
