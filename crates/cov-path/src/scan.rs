@@ -233,7 +233,13 @@ pub fn field_at(text: &str, line: usize, col: usize) -> Option<(String, (usize, 
     let name: String = chars[start..end].iter().collect();
     // The value: from the first character after the colon to the comma or bracket that
     // ends it at its own level.
-    let mut v = colon + 1;
+    Some((name, pos[start], value_from(&written, &chars, colon + 1)))
+}
+
+/// The value written from `v` in `written` (`chars`: its [`code_of`], comments
+/// blanked and strings' contents replaced), blanks before it skipped, to the comma, line end or closing bracket that
+/// ends it at its own level: at most 40 characters, trailing blanks trimmed.
+fn value_from(written: &[char], chars: &[char], mut v: usize) -> String {
     while v < chars.len() && chars[v].is_whitespace() {
         v += 1;
     }
@@ -249,13 +255,12 @@ pub fn field_at(text: &str, line: usize, col: usize) -> Option<(String, (usize, 
         }
         w += 1;
     }
-    let value: String = written[v..w]
+    written[v..w]
         .iter()
         .take(40)
         .collect::<String>()
         .trim_end()
-        .to_string();
-    Some((name, pos[start], value))
+        .to_string()
 }
 
 /// A field as [`field_at`] finds it: its name, the name's position (line, column, 1-based)
@@ -291,28 +296,7 @@ pub fn element_at(text: &str, line: usize, col: usize) -> Option<(Field, usize, 
     };
     let (l, c) = pos[open];
     let field = field_at(text, l, c)?;
-    // The element: from `at` (skipping blanks) to the comma or bracket that ends it.
-    let mut v = at;
-    while v < chars.len() && chars[v].is_whitespace() {
-        v += 1;
-    }
-    let (mut depth, mut w) = (0usize, v);
-    while w < chars.len() {
-        match chars[w] {
-            '(' | '[' | '{' => depth += 1,
-            ')' | ']' | '}' if depth == 0 => break,
-            ')' | ']' | '}' => depth -= 1,
-            ',' | '\n' if depth == 0 => break,
-            _ => {}
-        }
-        w += 1;
-    }
-    let element: String = written[v..w]
-        .iter()
-        .take(40)
-        .collect::<String>()
-        .trim_end()
-        .to_string();
+    let element = value_from(&written, &chars, at);
     Some((field, index, element))
 }
 
