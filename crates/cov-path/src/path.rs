@@ -78,6 +78,21 @@ fn explain(
     ) {
         return found;
     }
+    // A value of the wrong type inside a parameter's list (`hessian: [40.0, "a", 15.0]`).
+    if let Some(((name, _, _), index, element)) = crate::scan::element_at(text, line, col)
+        && let Some(what) = expected_value(&rest, &element)
+        && !what.is_empty()
+    {
+        return (
+            line,
+            col,
+            format!(
+                "{prefix}parameter `{name}`: value {} = {}: expected {what}",
+                index + 1,
+                cov_core::echo(&element)
+            ),
+        );
+    }
     // An operator's parameters in the path author's words rather than the parser's; a
     // name outside a parameter's choices (an enum's variant) says which parameter.
     if !prefix.is_empty()
@@ -167,15 +182,18 @@ fn wrong_type(
 /// Whether ron's message `ron_message` at `(line, col)` of `text` (1-based, as ron
 /// reports it) is a decimal number where a whole number belongs: ron reads the digits
 /// before the `.` or the exponent's `e` as the whole number and then stops there, saying
-/// it expected a comma at the `.` (`128.0`), or, at the number's start, that `e` is no
-/// digit (`9e1`).
+/// it expected a comma (or a tuple's closing parenthesis) at the `.` (`128.0`), or, at the
+/// number's start, that `e` is no digit (`9e1`).
 pub fn decimal_for_whole(ron_message: &str, text: &str, line: usize, col: usize) -> bool {
+    // ron does not count a leading byte-order mark in its columns.
+    let text = text.strip_prefix('\u{feff}').unwrap_or(text);
     let Some(row) = text.lines().nth(line.saturating_sub(1)) else {
         return false;
     };
     let chars: Vec<char> = row.chars().collect();
     let at = col.saturating_sub(1);
-    if ron_message == "Expected comma" {
+    // After the last value of a tuple ron expects its closing parenthesis instead.
+    if ron_message == "Expected comma" || ron_message.starts_with("Expected closing `)`") {
         let digit_before = at > 0 && chars.get(at - 1).is_some_and(|c| c.is_ascii_digit());
         return digit_before && matches!(chars.get(at), Some('.' | 'e' | 'E'));
     }
@@ -188,6 +206,28 @@ pub fn decimal_for_whole(ron_message: &str, text: &str, line: usize, col: usize)
         return number.contains(['.', 'e', 'E']) && number.replace('_', "").parse::<f64>().is_ok();
     }
     false
+}
+
+/// The column (1-based, as ron counts) where the number that `(line, col)` of `text`
+/// points into or just after its sign begins: ron reports a decimal where a whole number
+/// belongs at its `.`, and a negative whole number out of range after its `-`.
+pub fn number_start(text: &str, line: usize, col: usize) -> usize {
+    let text = text.strip_prefix('\u{feff}').unwrap_or(text);
+    let row: Vec<char> = text
+        .lines()
+        .nth(line.saturating_sub(1))
+        .unwrap_or("")
+        .chars()
+        .collect();
+    let mut c = col.clamp(1, row.len().max(1));
+    while c > 1
+        && row
+            .get(c - 2)
+            .is_some_and(|ch| ch.is_ascii_digit() || matches!(ch, '_' | '.' | '+' | '-'))
+    {
+        c -= 1;
+    }
+    c
 }
 
 /// What is wrong with a number written in another base (`0x10`, `0b1`, `0o7`, signed or

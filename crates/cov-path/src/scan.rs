@@ -236,9 +236,10 @@ pub fn field_at(text: &str, line: usize, col: usize) -> Option<(String, (usize, 
     Some((name, pos[start], value_from(&written, &chars, colon + 1)))
 }
 
-/// The value written from `v` in `written` (`chars`: its [`code_of`], comments
-/// blanked and strings' contents replaced), blanks before it skipped, to the comma, line end or closing bracket that
-/// ends it at its own level: at most 40 characters, trailing blanks trimmed.
+/// The value written from `v` in `written` (`chars`: its [`code_of`], comments blanked
+/// and strings' contents replaced), blanks before it skipped, to the comma, line end or
+/// closing bracket that ends it at its own level: at most 40 characters, comments and
+/// runs of blanks read as one space, trailing blanks trimmed.
 fn value_from(written: &[char], chars: &[char], mut v: usize) -> String {
     while v < chars.len() && chars[v].is_whitespace() {
         v += 1;
@@ -255,24 +256,34 @@ fn value_from(written: &[char], chars: &[char], mut v: usize) -> String {
         }
         w += 1;
     }
-    written[v..w]
-        .iter()
-        .take(40)
-        .collect::<String>()
-        .trim_end()
-        .to_string()
+    // As written, but a comment (blank in `chars`) and every run of blanks read as one
+    // space, so that a value written over several lines echoes on one.
+    let mut out = String::new();
+    for (c, code) in written[v..w].iter().zip(&chars[v..w]) {
+        if code.is_whitespace() {
+            if !out.ends_with(' ') {
+                out.push(' ');
+            }
+        } else {
+            out.push(*c);
+        }
+        if out.chars().count() >= 40 {
+            break;
+        }
+    }
+    out.trim_end().to_string()
 }
 
 /// A field as [`field_at`] finds it: its name, the name's position (line, column, 1-based)
 /// and its value as written.
 pub type Field = (String, (usize, usize), String);
 
-/// The tuple element ron stopped at in RON `text`, `(line, col)` (1-based) being in it
-/// or just before it (`(0.0, "a", 1.3)` refused at `"a"`, or at a fourth value): the
-/// field the tuple is the value of (as [`field_at`] gives it: name, name's position,
-/// the tuple as written), the element's index from 0, and the element as written (at
-/// most 40 characters). `None` outside a tuple in parentheses, or for a tuple that is no
-/// field's value.
+/// The element of a tuple or list that ron stopped at in RON `text`, `(line, col)`
+/// (1-based) being in it or just before it (`(0.0, "a", 1.3)` refused at `"a"`, or at a
+/// fourth value): the field the tuple or list is the value of (as [`field_at`] gives it:
+/// name, name's position, the value as written), the element's index from 0, and the
+/// element as written ([`field_at`]'s reading). `None` outside a tuple in parentheses or
+/// a list in brackets, or for one that is no field's value.
 pub fn element_at(text: &str, line: usize, col: usize) -> Option<(Field, usize, String)> {
     let text = text.strip_prefix('\u{feff}').unwrap_or(text);
     let written: Vec<char> = text.chars().collect();
@@ -287,8 +298,8 @@ pub fn element_at(text: &str, line: usize, col: usize) -> Option<(Field, usize, 
         i -= 1;
         match chars[i] {
             ')' | ']' | '}' => depth += 1,
-            '(' if depth == 0 => break i,
-            '[' | '{' if depth == 0 => return None,
+            '(' | '[' if depth == 0 => break i,
+            '{' if depth == 0 => return None,
             '(' | '[' | '{' => depth -= 1,
             ',' if depth == 0 => index += 1,
             _ => {}

@@ -556,9 +556,26 @@ fn found_at(text: &str, line: usize, col: usize) -> String {
     format!("`{token}`")
 }
 
+/// A decimal number where a whole number belongs, at `(line, col)` of `text` (its `.`,
+/// or its start): said of its field, or of its place in a tuple.
+fn whole_words(text: &str, line: usize, col: usize) -> Option<String> {
+    let start = cov_path::number_start(text, line, col);
+    const WORDS: &str = "expected a whole number, found a decimal number";
+    if let Some((name, _, value)) = cov_path::field_at(text, line, start) {
+        return Some(format!("`{name}` = {}: {WORDS}", cov_core::echo(&value)));
+    }
+    let ((name, _, _), index, element) = cov_path::element_at(text, line, start)?;
+    Some(format!(
+        "`{name}`: value {} = {}: {WORDS}",
+        index + 1,
+        cov_core::echo(&element)
+    ))
+}
+
 /// ron's message `message` at `(line, col)` of `text` said of a tuple's field, when it
 /// is about the tuple: its number of values (`position: (0.0, 0.8)`), a value of the wrong
-/// type in it (`radiance: (10.0, nan, 9.0)`), or one value too many. `None` otherwise.
+/// type in it (`radiance: (10.0, nan, 9.0)`), one value too many, or values where named
+/// fields belong (`shutter: (0.0, 0.1)`). `None` otherwise.
 fn tuple_words(text: &str, line: usize, col: usize, message: &str) -> Option<String> {
     if let Some(rest) = message.strip_prefix("Expected a tuple of size ")
         && let Some((want, found)) = rest.split_once(" but found ")
@@ -570,10 +587,18 @@ fn tuple_words(text: &str, line: usize, col: usize, message: &str) -> Option<Str
             cov_core::echo(&value)
         ));
     }
-    let ((name, _, _), index, element) = cov_path::element_at(text, line, col)?;
+    // A negative number is reported after its sign.
+    let start = cov_path::number_start(text, line, col);
+    let ((name, _, _), index, element) = cov_path::element_at(text, line, start)?;
     let element = cov_core::echo(&element);
+    if message.starts_with("Found invalid std identifier") {
+        return Some(format!(
+            "`{name}`: expected named fields (`name: value`) in the parentheses, found `{element}`"
+        ));
+    }
     if message.starts_with("Expected closing `)`") {
         // One value too many follows a comma; after a value, a comma is missing.
+        let text = text.strip_prefix('\u{feff}').unwrap_or(text);
         let before = text
             .lines()
             .take(line.saturating_sub(1))
@@ -591,10 +616,16 @@ fn tuple_words(text: &str, line: usize, col: usize, message: &str) -> Option<Str
             .then(|| format!("`{name}` has more than {index} values (found `{element}`)"));
     }
     let what = cov_path::expected_value(message, &element)?;
-    Some(format!(
-        "`{name}`: value {} = {element}: expected {what}",
-        index + 1
-    ))
+    Some(if element.is_empty() {
+        format!("`{name}`: value {} is missing: expected {what}", index + 1)
+    } else if what.is_empty() {
+        format!(
+            "`{name}`: value {} = {element} is out of range for a whole number",
+            index + 1
+        )
+    } else {
+        format!("`{name}`: value {} = {element}: expected {what}", index + 1)
+    })
 }
 
 impl SceneFile {
@@ -621,12 +652,9 @@ impl SceneFile {
             {
                 message = format!("`{name}` = {}: {words}", cov_core::echo(&value));
             } else if cov_path::decimal_for_whole(&message, text, line, col)
-                && let Some((name, _, value)) = field()
+                && let Some(words) = whole_words(text, line, col)
             {
-                message = format!(
-                    "`{name}` = {}: expected a whole number, found a decimal number",
-                    cov_core::echo(&value)
-                );
+                message = words;
             } else if let ron::Error::Message(m) = &e.code
                 && let Some((name, ..)) = field()
             {

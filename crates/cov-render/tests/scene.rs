@@ -518,6 +518,54 @@ fn a_syntax_error_says_what_it_found() {
     );
     let e = error(&scene(&[("LOOK", "(0.0, 1.0 0.0)")]));
     assert!(e.ends_with("Expected comma, found `0.0`"), "{e}");
+    let e = error(&scene(&[("LOOK", "(0.0, , 0.0)")]));
+    assert!(
+        e.ends_with("`look_at`: value 2 is missing: expected a number"),
+        "{e}"
+    );
+    // A tuple written over lines, with a comment, echoes on one line.
+    let e = error(&scene(&[("LOOK", "(0.0, // aim\n        1.0)")]));
+    assert!(
+        e.ends_with("`look_at` = (0.0, 1.0): expected 3 values, found 2"),
+        "{e}"
+    );
+    // Named fields given as bare values.
+    let e = error(&scene(&[("LENS", ", shutter: (0.0, 0.1)")]));
+    assert!(
+        e.ends_with("`shutter`: expected named fields (`name: value`) in the parentheses, found `0.0`"),
+        "{e}"
+    );
+    // A whole number inside a tuple: decimal, exponent, out of range (its sign kept).
+    let checker = |checks: &str| {
+        let t = r#""c": Diffuse(albedo: (0.5, 0.5, 0.5), texture: "t")"#;
+        let mut s = scene(&[("MAT", t)]);
+        s = s.replace(
+            "materials:",
+            &format!("textures: {{ \"t\": Checker(checks: {checks}, a: (0.1, 0.1, 0.1), b: (0.9, 0.9, 0.9)) }},\n    materials:"),
+        );
+        error(&s)
+    };
+    let e = checker("(8, 8.5)");
+    assert!(
+        e.ends_with("`checks`: value 2 = 8.5: expected a whole number, found a decimal number"),
+        "{e}"
+    );
+    let e = checker("(8e0, 8)");
+    assert!(
+        e.ends_with("`checks`: value 1 = 8e0: expected a whole number, found a decimal number"),
+        "{e}"
+    );
+    let e = checker("(8, -8)");
+    assert!(
+        e.ends_with("`checks`: value 2 = -8 is out of range for a whole number"),
+        "{e}"
+    );
+    // A byte-order mark does not shift the columns the checks read.
+    let e = error(&format!("\u{feff}{}", scene(&[("width: 8", "width: 8.5")])));
+    assert!(
+        e.ends_with("`width` = 8.5: expected a whole number, found a decimal number"),
+        "{e}"
+    );
 }
 
 /// OBJ files a new user brought: a byte-order mark and a Latin-1 comment are read past;
