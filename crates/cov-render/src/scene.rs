@@ -18,9 +18,11 @@
 //! Every number is checked as it is read (finite, in range), so a bad value is reported
 //! at its own line and column; names that refer elsewhere (a material, an OBJ file) are
 //! checked after reading and reported where they are written. An OBJ file the reader
-//! refuses is reported at the `Mesh` that names it, with the OBJ's own line (a statement
-//! that does not parse, a face that refers to a vertex, texture coordinate or normal the
-//! file does not have, a coordinate that is not finite).
+//! refuses is reported at the `Mesh` that names it, with the OBJ's own line: a statement
+//! that does not parse, a face that refers to a vertex the file does not have by the end
+//! of the face's object (or a texture coordinate or normal, where the file has some: the
+//! reader ignores `vt` and `vn` indices otherwise), a vertex coordinate that is not
+//! finite. A comment after a statement (`v 0 1 0 # top`) is read past.
 //!
 //! | field | unit | meaning |
 //! |---|---|---|

@@ -1290,14 +1290,21 @@ fn load_obj(path: &Path, limit: usize) -> Result<Obj, String> {
     // letter in a comment or a name) stops the reader: both are read past, the second as
     // U+FFFD, which no number or index contains.
     let bytes = bytes.strip_prefix(b"\xef\xbb\xbf").unwrap_or(&bytes);
-    let text = String::from_utf8_lossy(bytes);
+    let text = without_trailing_comments(&String::from_utf8_lossy(bytes)).into_owned();
+    if text.contains('\r') && !text.contains('\n') {
+        return Err(
+            "its lines end with a lone carriage return (classic Mac OS); save it with LF or CRLF line ends"
+                .into(),
+        );
+    }
     // Materials come from the scene: an `mtllib` line is not followed (it could name a
     // device or a pipe).
     let no_materials = |_: &Path| Ok((Vec::new(), Default::default()));
     let (models, _materials) =
         tobj::load_obj_buf(&mut text.as_bytes(), &opts, no_materials).map_err(|e| {
             match obj_error_line(&text, e, &opts) {
-                Some(line) => format!("line {line}: {}", obj_error(e)),
+                Some((line, None)) => format!("line {line}: {}", obj_error(e)),
+                Some((line, Some(why))) => format!("line {line}: {why}"),
                 None => obj_error(e),
             }
         })?;
@@ -1388,8 +1395,38 @@ fn load_obj(path: &Path, limit: usize) -> Result<Obj, String> {
     })
 }
 
+/// An OBJ's `text` with a comment after a vertex, normal, texture coordinate or face
+/// statement (`v 0 1 0 # top`) taken off, which the reader would read as more numbers;
+/// every line stays where it was.
+fn without_trailing_comments(text: &str) -> std::borrow::Cow<'_, str> {
+    let statement = |l: &str| matches!(l.split_whitespace().next(), Some("v" | "vt" | "vn" | "f"));
+    if !text.lines().any(|l| statement(l) && l.contains('#')) {
+        return std::borrow::Cow::Borrowed(text);
+    }
+    let mut out = String::with_capacity(text.len());
+    for piece in text.split_inclusive('\n') {
+        let (line, end) = match piece.strip_suffix('\n') {
+            Some(l) => (l, "\n"),
+            None => (piece, ""),
+        };
+        match line.find('#') {
+            Some(k) if statement(line) => {
+                out.push_str(&line[..k]);
+                // A CRLF line keeps its carriage return.
+                if line.ends_with('\r') {
+                    out.push('\r');
+                }
+            }
+            _ => out.push_str(line),
+        }
+        out.push_str(end);
+    }
+    std::borrow::Cow::Owned(out)
+}
+
 /// The line (from 1) of the first statement of an OBJ's `text` that the reader refuses
-/// with `e` (the reader does not give its line), or `None`.
+/// with `e` (the reader does not give its line), and what to say of it instead of
+/// [`obj_error`]'s words, if anything; `None` when no line is found.
 ///
 /// - A statement refused for its own text (a vertex, normal, texture coordinate or face
 ///   that does not parse, a weight of 0): the first statement of that kind that the
@@ -1397,23 +1434,26 @@ fn load_obj(path: &Path, limit: usize) -> Result<Obj, String> {
 /// - A face that refers to an element the file does not have: the first face with an
 ///   index beyond the vertices, texture coordinates or normals stated before it
 ///   (positive indices count from 1, negative ones back from the last).
-fn obj_error_line(text: &str, e: tobj::LoadError, opts: &tobj::LoadOptions) -> Option<usize> {
+fn obj_error_line(
+    text: &str,
+    e: tobj::LoadError,
+    opts: &tobj::LoadOptions,
+) -> Option<(usize, Option<String>)> {
     use tobj::LoadError as E;
     let no_materials = |_: &Path| Ok((Vec::new(), Default::default()));
     let alone = |line: &str| tobj::load_obj_buf(&mut line.as_bytes(), opts, no_materials).err() == Some(e);
     let keyword = match e {
-        E::PositionParseError | E::ScalingByZeroError => "v",
+        E::PositionParseError | E::ScalingByZeroError | E::ColorParseError => "v",
         E::NormalParseError => "vn",
         E::TexcoordParseError => "vt",
-        E::FaceParseError => "f",
+        E::FaceParseError | E::InvalidPolygon => "f",
         E::FaceVertexOutOfBounds | E::FaceTexCoordOutOfBounds | E::FaceNormalOutOfBounds => "",
         _ => return None,
     };
     if !keyword.is_empty() {
-        return text
-            .lines()
-            .enumerate()
-            .find_map(|(i, l)| (l.split_whitespace().next() == Some(keyword) && alone(l)).then_some(i + 1));
+        return text.lines().enumerate().find_map(|(i, l)| {
+            (l.split_whitespace().next() == Some(keyword) && alone(l)).then_some((i + 1, None))
+        });
     }
     // Which part of a face's `v/vt/vn` entries is out of bounds. The reader resolves a
     // negative index against the elements stated so far and checks the result when it
@@ -1454,16 +1494,22 @@ fn obj_error_line(text: &str, e: tobj::LoadError, opts: &tobj::LoadOptions) -> O
         match words.next() {
             w if kind(w) == Some(part) => so_far += 1,
             Some("f") => {
-                let beyond = words.any(|w| {
-                    let Some(k) = w.split('/').nth(part).and_then(|t| t.parse::<i64>().ok()) else {
-                        return false;
-                    };
+                let beyond = words.find_map(|w| {
+                    let k = w.split('/').nth(part).and_then(|t| t.parse::<i64>().ok())?;
                     let resolved = if k < 0 { so_far + k } else { k - 1 };
                     let none = part > 0 && resolved == -1;
-                    !none && (resolved < 0 || resolved >= at_close[i])
+                    (!none && (resolved < 0 || resolved >= at_close[i])).then_some(resolved)
                 });
-                if beyond {
-                    return Some(i + 1);
+                if let Some(r) = beyond {
+                    // An element the file states only after the object closed.
+                    let later = r >= 0 && r < before[lines.len()];
+                    let what = ["vertex (`v`)", "texture coordinate (`vt`)", "normal (`vn`)"][part];
+                    let why = later.then(|| {
+                        format!(
+                            "a face (`f`) refers to a {what} stated only after its object ends (at the next `o` or `g` statement); state it before"
+                        )
+                    });
+                    return Some((i + 1, why));
                 }
             }
             _ => {}
@@ -1485,6 +1531,13 @@ fn obj_error(e: tobj::LoadError) -> String {
         E::FaceTexCoordOutOfBounds => "a face (`f`) refers to a texture coordinate (`vt`) the file does not have".into(),
         E::FaceNormalOutOfBounds => "a face (`f`) refers to a normal (`vn`) the file does not have".into(),
         E::ScalingByZeroError => "a vertex (`v`) with a weight `w` of 0".into(),
+        E::ColorParseError => {
+            "a vertex (`v`) whose numbers are not three or four coordinates, or three and a colour of three".into()
+        }
+        E::FaceColorOutOfBounds => {
+            "some vertices (`v`) have a colour and others none: give every vertex one, or none".into()
+        }
+        E::InvalidPolygon => "a face (`f`) without vertices".into(),
         e => cov_core::one_line(&e.to_string()),
     }
 }

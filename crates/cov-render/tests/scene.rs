@@ -569,8 +569,9 @@ fn a_syntax_error_says_what_it_found() {
 }
 
 /// OBJ files a new user brought: a byte-order mark and a Latin-1 comment are read past;
-/// a bad vertex, a bad face, a face beyond the vertices or the normals stated before it,
-/// a NaN coordinate (each with the OBJ's line), faces
+/// a bad vertex, a bad face, an empty face, a colour of two numbers, a face beyond the
+/// vertices or the normals its object has, a NaN coordinate (each with the OBJ's line),
+/// a comment after a statement (read past), lines ended by a lone carriage return, faces
 /// of no area and a mesh scaled below the least size each say what is wrong, in one
 /// positioned line.
 #[test]
@@ -578,7 +579,7 @@ fn obj_files_say_what_is_wrong_with_them() {
     let dir = std::env::temp_dir().join(format!("covtrace-obj-test-{}", std::process::id()));
     std::fs::create_dir_all(&dir).expect("temp dir");
     let tri = "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n";
-    let cases: [(&str, Vec<u8>, &str, &str); 11] = [
+    let cases: [(&str, Vec<u8>, &str, &str); 15] = [
         ("bom.obj", [&b"\xef\xbb\xbf"[..], tri.as_bytes()].concat(), "", ""),
         (
             "latin1.obj",
@@ -626,7 +627,32 @@ fn obj_files_say_what_is_wrong_with_them() {
             "closed.obj",
             b"v 0 0 0\nv 1 0 0\no a\nf 1 2 3\no b\nv 0 1 0\nf 1 2 3\n".to_vec(),
             "",
-            "line 4: a face (`f`) refers to a vertex (`v`)",
+            "line 4: a face (`f`) refers to a vertex (`v`) stated only after its object ends",
+        ),
+        // A comment after a statement is not read as more numbers.
+        (
+            "comment.obj",
+            b"v 0 0 0 # origin\nv 1 0 0\nv 0 1 0\nf 1 2 3 # the face\n".to_vec(),
+            "",
+            "",
+        ),
+        (
+            "colour.obj",
+            [tri.as_bytes(), b"v 0 0 1 0.5 0.5\n"].concat(),
+            "",
+            "line 5: a vertex (`v`) whose numbers are not three or four coordinates",
+        ),
+        (
+            "empty.obj",
+            [tri.as_bytes(), b"f\n"].concat(),
+            "",
+            "line 5: a face (`f`) without vertices",
+        ),
+        (
+            "mac.obj",
+            tri.replace('\n', "\r").into_bytes(),
+            "",
+            "its lines end with a lone carriage return",
         ),
         (
             "nan.obj",
