@@ -437,7 +437,7 @@ pub fn run(a: &RenderArgs) -> Result<String, String> {
                 let expected = world
                     .frame_problem(bad)
                     .unwrap_or_default()
-                    .replace("this one", &format!("frame {bad}"));
+                    .replace("at this one", &format!("at frame {bad}"));
                 let which = if bad == last {
                     format!("frame {last} is")
                 } else {

@@ -224,7 +224,7 @@ fn frames_are_checked_before_any_is_rendered() {
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(
         err.contains("--frames 0..9: frames 2 to 9 are out of range: must be a frame at which every shape and the camera stay within")
-            && err.contains("(frame 2 moves one to"),
+            && err.contains("(at frame 2, one of them reaches"),
         "{err}"
     );
 }

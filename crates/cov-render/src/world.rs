@@ -373,9 +373,14 @@ impl World {
         let (_, t0, t1) = self.frame_times(frame);
         let reach = self.geometry.reach(t0, t1).max(self.camera.reach(t0, t1));
         (reach > MAX_COORD).then(|| {
+            // Rounded, a distance just past the bound would read as the bound itself.
+            let shown = cov_core::approx(reach);
+            let shown = match shown.parse::<f64>() {
+                Ok(v) if v <= MAX_COORD => format!("{reach:e}"),
+                _ => shown,
+            };
             format!(
-                "a frame at which every shape and the camera stay within ±{MAX_COORD:e} m (this one moves one to {} m)",
-                cov_core::approx(reach)
+                "a frame at which every shape and the camera stay within ±{MAX_COORD:e} m (at this one, one of them reaches {shown} m)"
             )
         })
     }
