@@ -233,7 +233,13 @@ impl TextureMap {
                     "the image is larger than textures are read, up to {MAX_TEXTURE_SIDE} texels per side"
                 ));
             }
-            Err(e) if exr => exr_size().ok_or_else(|| one(&e))?,
+            Err(e) if exr => exr_size().ok_or_else(|| match std::fs::metadata(path) {
+                Ok(m) if m.len() == 0 => "the file is empty".to_string(),
+                _ => format!(
+                    "{} (its header cannot be read: the file may be cut short or damaged)",
+                    one(&e)
+                ),
+            })?,
             Err(e) => return Err(one(&e)),
         };
         if w == 0 || h == 0 || w > MAX_TEXTURE_SIDE || h > MAX_TEXTURE_SIDE {
@@ -249,6 +255,11 @@ impl TextureMap {
                 let grey = grey_exr(path).ok_or_else(|| match exr_channels(path) {
                     // The channels are there: the data is what the decoder refused (a
                     // file cut short, a damaged block).
+                    // One grey channel, which only our own reader reads: the decoder's
+                    // words would be about colour channels.
+                    Some(c) if has_colour(&c) && !c.iter().any(|n| n == "R") => {
+                        "its channel Y cannot be read: the file may be cut short or damaged".to_string()
+                    }
                     Some(c) if has_colour(&c) => {
                         format!("{} (the file may be cut short or damaged)", one(&e))
                     }
@@ -802,7 +813,21 @@ mod tests {
         let cut = dir.join("cut.exr");
         std::fs::write(&cut, &bytes[..bytes.len() - 8]).expect("write EXR");
         let e = TextureMap::load(&cut, DVec2::ONE).unwrap_err();
-        assert!(e.ends_with("(the file may be cut short or damaged)"), "{e}");
+        assert_eq!(
+            e,
+            "its channel Y cannot be read: the file may be cut short or damaged"
+        );
+        let empty = dir.join("empty.exr");
+        std::fs::write(&empty, b"").expect("write EXR");
+        let e = TextureMap::load(&empty, DVec2::ONE).unwrap_err();
+        assert_eq!(e, "the file is empty");
+        let head = dir.join("head.exr");
+        std::fs::write(&head, &bytes[..6]).expect("write EXR");
+        let e = TextureMap::load(&head, DVec2::ONE).unwrap_err();
+        assert!(
+            e.ends_with("(its header cannot be read: the file may be cut short or damaged)"),
+            "{e}"
+        );
         std::fs::remove_dir_all(&dir).expect("clean up");
     }
 
