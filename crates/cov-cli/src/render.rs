@@ -434,10 +434,7 @@ pub fn run(a: &RenderArgs) -> Result<String, String> {
                         ok = mid;
                     }
                 }
-                let expected = world
-                    .frame_problem(bad)
-                    .unwrap_or_default()
-                    .replace("at this one", &format!("at frame {bad}"));
+                let expected = world.frame_problem(bad).unwrap_or_default();
                 let which = if bad == last {
                     format!("frame {last} is")
                 } else {

@@ -127,9 +127,14 @@ fn explain(
         );
     }
     if decimal_for_whole(&rest, text, line, col) {
-        let message = match crate::scan::field_at(text, line, col) {
-            Some((name, _, value)) => format!(
-                "{prefix}parameter `{name}` = {}: expected a whole number, found a decimal number",
+        const WORDS: &str = "expected a whole number, found a decimal number";
+        let message = match whole_number_at(text, line, col) {
+            Some((name, None, value)) => {
+                format!("{prefix}parameter `{name}` = {}: {WORDS}", cov_core::echo(&value))
+            }
+            Some((name, Some(k), value)) => format!(
+                "{prefix}parameter `{name}`: value {} = {}: {WORDS}",
+                k + 1,
                 cov_core::echo(&value)
             ),
             None => format!("{prefix}expected a whole number here, found a decimal number"),
@@ -185,12 +190,7 @@ fn wrong_type(
 /// it expected a comma (or a tuple's closing parenthesis) at the `.` (`128.0`), or, at the
 /// number's start, that `e` is no digit (`9e1`).
 pub fn decimal_for_whole(ron_message: &str, text: &str, line: usize, col: usize) -> bool {
-    // ron does not count a leading byte-order mark in its columns.
-    let text = text.strip_prefix('\u{feff}').unwrap_or(text);
-    let Some(row) = text.lines().nth(line.saturating_sub(1)) else {
-        return false;
-    };
-    let chars: Vec<char> = row.chars().collect();
+    let chars = row(text, line);
     let at = col.saturating_sub(1);
     // After the last value of a tuple ron expects its closing parenthesis instead.
     if ron_message == "Expected comma" || ron_message.starts_with("Expected closing `)`") {
@@ -212,13 +212,7 @@ pub fn decimal_for_whole(ron_message: &str, text: &str, line: usize, col: usize)
 /// points into or just after its sign begins: ron reports a decimal where a whole number
 /// belongs at its `.`, and a negative whole number out of range after its `-`.
 pub fn number_start(text: &str, line: usize, col: usize) -> usize {
-    let text = text.strip_prefix('\u{feff}').unwrap_or(text);
-    let row: Vec<char> = text
-        .lines()
-        .nth(line.saturating_sub(1))
-        .unwrap_or("")
-        .chars()
-        .collect();
+    let row = row(text, line);
     let mut c = col.clamp(1, row.len().max(1));
     while c > 1
         && row
@@ -228,6 +222,30 @@ pub fn number_start(text: &str, line: usize, col: usize) -> usize {
         c -= 1;
     }
     c
+}
+
+/// Where a decimal number that ron refused as a whole number ([`decimal_for_whole`], at
+/// `(line, col)` of `text`) is written: the field's name, the number's index (from 0) in
+/// the tuple or list that is the field's value (`None`: the field's value itself), and
+/// the value as written.
+pub fn whole_number_at(text: &str, line: usize, col: usize) -> Option<(String, Option<usize>, String)> {
+    let start = number_start(text, line, col);
+    if let Some((name, _, value)) = crate::scan::field_at(text, line, start) {
+        return Some((name, None, value));
+    }
+    let ((name, _, _), index, element) = crate::scan::element_at(text, line, start)?;
+    Some((name, Some(index), element))
+}
+
+/// Row `line` (from 1) of `text` as characters; a leading byte-order mark is not counted,
+/// as ron does not count it in its columns.
+fn row(text: &str, line: usize) -> Vec<char> {
+    let text = text.strip_prefix('\u{feff}').unwrap_or(text);
+    text.lines()
+        .nth(line.saturating_sub(1))
+        .unwrap_or("")
+        .chars()
+        .collect()
 }
 
 /// What is wrong with a number written in another base (`0x10`, `0b1`, `0o7`, signed or

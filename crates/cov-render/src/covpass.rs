@@ -742,11 +742,28 @@ fn same_surface(world: &World, a: &Hit, b: &Hit) -> bool {
             && world.material_textures.get(i) == world.material_textures.get(j))
 }
 
-/// `edge` in `best` if it is the first found or narrower than the one there: the
-/// sharpest edge's window wins.
-fn keep_narrowest(best: &mut Option<Silhouette>, edge: Silhouette) {
-    if best.as_ref().is_none_or(|b| edge.radius < b.radius) {
-        *best = Some(edge);
+/// An edge found by a probe, kept in `best` if it is the first found or narrower than the
+/// one there (the sharpest edge's window wins): at `depth` from the probes' origin, its
+/// nearer surface moving at `velocity`, its full-contrast window of radius `full` weighed
+/// by the [`contrast`] of the step between the radiances `here` and `there` (none when
+/// both sides are alike).
+fn keep_narrowest(
+    best: &mut Option<Silhouette>,
+    (here, there): (f64, f64),
+    (depth, velocity): (f64, DVec3),
+    full: f64,
+) {
+    let c = contrast(here, there);
+    if c <= 0.0 {
+        return;
+    }
+    let radius = full / c.sqrt();
+    if best.as_ref().is_none_or(|b| radius < b.radius) {
+        *best = Some(Silhouette {
+            depth,
+            radius,
+            velocity,
+        });
     }
 }
 
@@ -852,19 +869,12 @@ fn nearest_silhouette(
         // The path's own side, once, seen along the first probe that finds an edge (half a
         // pixel from the path's own ray).
         let l_here = *here.get_or_insert_with(|| direct_proxy(world, Some(hit), r.dir, footprint));
-        let c = contrast(l_here, direct_proxy(world, h.as_ref(), r.dir, footprint));
-        if c <= 0.0 {
-            continue;
-        }
         // Half a pixel's footprint at that depth, its window weighed by the contrast.
-        let radius = (cam.tan_x * depth / cam.width as f64).max(1e-9) / c.sqrt();
         keep_narrowest(
             &mut best,
-            Silhouette {
-                depth,
-                radius,
-                velocity: vel,
-            },
+            (l_here, direct_proxy(world, h.as_ref(), r.dir, footprint)),
+            (depth, vel),
+            (cam.tan_x * depth / cam.width as f64).max(1e-9),
         );
     }
     best
@@ -906,18 +916,11 @@ fn segment_edge(
             continue;
         };
         let l_here = *here.get_or_insert_with(|| direct_proxy(world, Some(next), wi, footprint));
-        let c = contrast(l_here, direct_proxy(world, h.as_ref(), dir, footprint));
-        if c <= 0.0 {
-            continue;
-        }
-        let radius = (tan * depth).max(1e-9) / c.sqrt();
         keep_narrowest(
             &mut best,
-            Silhouette {
-                depth,
-                radius,
-                velocity: vel,
-            },
+            (l_here, direct_proxy(world, h.as_ref(), dir, footprint)),
+            (depth, vel),
+            (tan * depth).max(1e-9),
         );
     }
     best

@@ -561,17 +561,11 @@ fn found_at(text: &str, line: usize, col: usize) -> String {
 /// A decimal number where a whole number belongs, at `(line, col)` of `text` (its `.`,
 /// or its start): said of its field, or of its place in a tuple.
 fn whole_words(text: &str, line: usize, col: usize) -> Option<String> {
-    let start = cov_path::number_start(text, line, col);
     const WORDS: &str = "expected a whole number, found a decimal number";
-    if let Some((name, _, value)) = cov_path::field_at(text, line, start) {
-        return Some(format!("`{name}` = {}: {WORDS}", cov_core::echo(&value)));
-    }
-    let ((name, _, _), index, element) = cov_path::element_at(text, line, start)?;
-    Some(format!(
-        "`{name}`: value {} = {}: {WORDS}",
-        index + 1,
-        cov_core::echo(&element)
-    ))
+    Some(match cov_path::whole_number_at(text, line, col)? {
+        (name, None, value) => format!("`{name}` = {}: {WORDS}", cov_core::echo(&value)),
+        (name, Some(k), value) => format!("`{name}`: value {} = {}: {WORDS}", k + 1, cov_core::echo(&value)),
+    })
 }
 
 /// ron's message `message` at `(line, col)` of `text` said of a tuple's field, when it

@@ -772,38 +772,27 @@ mod tests {
         let dir = std::env::temp_dir().join(format!("covtrace-grey-exr-{}", std::process::id()));
         std::fs::create_dir_all(&dir).expect("temp dir");
         let path = dir.join("y.exr");
-        // 4 × 2 texels: the top row 0.75, the bottom row 0.25.
-        let (w, h) = (4usize, 2usize);
-        let layer = Layer::new(
-            (w, h),
-            LayerAttributes::named(""),
-            Encoding::FAST_LOSSLESS,
-            SpecificChannels::build()
-                .with_channel("Y")
-                .with_pixel_fn(|p: Vec2<usize>| (if p.y() == 0 { 0.75f32 } else { 0.25f32 },)),
-        );
-        Image::from_layer(layer)
-            .write()
-            .to_file(&path)
-            .expect("write EXR");
+        // An EXR of 4 × 2 texels and one channel `name`.
+        let write = |path: &Path, name: &str, texel: fn(Vec2<usize>) -> f32| {
+            let layer = Layer::new(
+                (4usize, 2usize),
+                LayerAttributes::named(""),
+                Encoding::FAST_LOSSLESS,
+                SpecificChannels::build()
+                    .with_channel(name)
+                    .with_pixel_fn(|p: Vec2<usize>| (texel(p),)),
+            );
+            Image::from_layer(layer).write().to_file(path).expect("write EXR");
+        };
+        // The top row 0.75, the bottom row 0.25.
+        write(&path, "Y", |p| if p.y() == 0 { 0.75 } else { 0.25 });
         let t = TextureMap::load(&path, DVec2::ONE).expect("a Y-only EXR loads");
         assert_eq!(t.size(), (4, 2));
         assert_eq!(t.rgb(DVec2::new(0.375, 0.75), 0.0), DVec3::splat(0.75));
         assert_eq!(t.rgb(DVec2::new(0.375, 0.25), 0.0), DVec3::splat(0.25));
         // An EXR of other channels names them; one cut short is not said to lack channels.
         let depth = dir.join("z.exr");
-        let layer = Layer::new(
-            (w, h),
-            LayerAttributes::named(""),
-            Encoding::FAST_LOSSLESS,
-            SpecificChannels::build()
-                .with_channel("Z")
-                .with_pixel_fn(|_: Vec2<usize>| (1.0f32,)),
-        );
-        Image::from_layer(layer)
-            .write()
-            .to_file(&depth)
-            .expect("write EXR");
+        write(&depth, "Z", |_| 1.0);
         let e = TextureMap::load(&depth, DVec2::ONE).unwrap_err();
         assert!(
             e.ends_with("(an EXR texture needs R, G and B channels, or Y; this one has Z)"),

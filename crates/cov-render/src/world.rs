@@ -380,7 +380,7 @@ impl World {
                 _ => shown,
             };
             format!(
-                "a frame at which every shape and the camera stay within ±{MAX_COORD:e} m (at this one, one of them reaches {shown} m)"
+                "a frame at which every shape and the camera stay within ±{MAX_COORD:e} m (at frame {frame}, one of them reaches {shown} m)"
             )
         })
     }
@@ -1469,7 +1469,9 @@ fn obj_error_line(
         E::FaceTexCoordOutOfBounds => 1,
         _ => 2,
     };
-    let first = |l: &str| l.split_whitespace().next().map(str::to_owned);
+    fn first(l: &str) -> Option<&str> {
+        l.split_whitespace().next()
+    }
     let kind = |w: Option<&str>| match w {
         Some("v") => Some(0),
         Some("vt") => Some(1),
@@ -1483,12 +1485,12 @@ fn obj_error_line(
     before.push(0i64);
     for l in &lines {
         let n = before.last().copied().unwrap_or(0);
-        before.push(n + i64::from(kind(first(l).as_deref()) == Some(part)));
+        before.push(n + i64::from(kind(first(l)) == Some(part)));
     }
     let mut at_close = vec![0i64; lines.len()];
     let mut close = before[lines.len()];
     for (i, l) in lines.iter().enumerate().rev() {
-        if matches!(first(l).as_deref(), Some("o" | "g")) {
+        if matches!(first(l), Some("o" | "g")) {
             close = before[i];
         }
         at_close[i] = close;
