@@ -477,64 +477,57 @@ fn small_inputs_cannot_ask_for_unbounded_work() {
 /// character there, or the end of the line.
 #[test]
 fn a_syntax_error_says_what_it_found() {
-    let e = error(&scene(&[("FOV", "40.0,,")]));
-    assert!(e.ends_with("Expected identifier, found `,`"), "{e}");
-    let e = error(&scene(&[("FOV", "4o")]));
-    assert!(e.ends_with("Expected comma, found `o`"), "{e}");
-    let e = error(&scene(&[("FOV", "40.0 width")]));
-    assert!(e.ends_with("Expected comma, found `width`"), "{e}");
-    // A value of the wrong type names its field and what it needs.
-    let e = error(&scene(&[("FOV", "\"wide\"")]));
-    assert!(e.ends_with("`fov` = \"wide\": expected a number"), "{e}");
-    let e = error(&scene(&[("FOV", "true")]));
-    assert!(e.ends_with("`fov` = true: expected a number"), "{e}");
-    // A decimal number where a whole number belongs: ron stops at its `.` or at its `e`.
-    let e = error(&scene(&[("width: 8", "width: 8.0")]));
-    assert!(
-        e.ends_with("`width` = 8.0: expected a whole number, found a decimal number"),
-        "{e}"
-    );
-    let e = error(&scene(&[("height: 8", "height: 8e0")]));
-    assert!(
-        e.ends_with("`height` = 8e0: expected a whole number, found a decimal number"),
-        "{e}"
-    );
-    // A tuple's values: how many, which one has the wrong type, one too many; a comma
-    // missing between two values stays a syntax error.
-    let e = error(&scene(&[("LOOK", "(0.0, 1.0)")]));
-    assert!(
-        e.ends_with("`look_at` = (0.0, 1.0): expected 3 values, found 2"),
-        "{e}"
-    );
-    let e = error(&scene(&[("LOOK", "(0.0, nan, 0.0)")]));
-    assert!(
-        e.ends_with("`look_at`: value 2 = nan: expected a finite number, not NaN"),
-        "{e}"
-    );
-    let e = error(&scene(&[("LOOK", "(0.0, 1.0, 0.0, 2.0)")]));
-    assert!(
-        e.ends_with("`look_at` has more than 3 values (found `2.0`)"),
-        "{e}"
-    );
-    let e = error(&scene(&[("LOOK", "(0.0, 1.0 0.0)")]));
-    assert!(e.ends_with("Expected comma, found `0.0`"), "{e}");
-    let e = error(&scene(&[("LOOK", "(0.0, , 0.0)")]));
-    assert!(
-        e.ends_with("`look_at`: value 2 is missing: expected a number"),
-        "{e}"
-    );
-    // A tuple written over lines, with a comment, echoes on one line.
-    let e = error(&scene(&[("LOOK", "(0.0, // aim\n        1.0)")]));
-    assert!(
-        e.ends_with("`look_at` = (0.0, 1.0): expected 3 values, found 2"),
-        "{e}"
-    );
-    // Named fields given as bare values.
-    let e = error(&scene(&[("LENS", ", shutter: (0.0, 0.1)")]));
-    assert!(
-        e.ends_with("`shutter`: expected named fields (`name: value`) in the parentheses, found `0.0`"),
-        "{e}"
-    );
+    // Each edit of the scene, and how the error's line ends.
+    let cases: &[((&str, &str), &str)] = &[
+        (("FOV", "40.0,,"), "Expected identifier, found `,`"),
+        (("FOV", "4o"), "Expected comma, found `o`"),
+        (("FOV", "40.0 width"), "Expected comma, found `width`"),
+        // A value of the wrong type names its field and what it needs.
+        (("FOV", "\"wide\""), "`fov` = \"wide\": expected a number"),
+        (("FOV", "true"), "`fov` = true: expected a number"),
+        // A decimal number where a whole number belongs: ron stops at its `.` or at its `e`.
+        (
+            ("width: 8", "width: 8.0"),
+            "`width` = 8.0: expected a whole number, found a decimal number",
+        ),
+        (
+            ("height: 8", "height: 8e0"),
+            "`height` = 8e0: expected a whole number, found a decimal number",
+        ),
+        // A tuple's values: how many, which one has the wrong type, one too many, one
+        // missing; a comma missing between two values stays a syntax error.
+        (
+            ("LOOK", "(0.0, 1.0)"),
+            "`look_at` = (0.0, 1.0): expected 3 values, found 2",
+        ),
+        (
+            ("LOOK", "(0.0, nan, 0.0)"),
+            "`look_at`: value 2 = nan: expected a finite number, not NaN",
+        ),
+        (
+            ("LOOK", "(0.0, 1.0, 0.0, 2.0)"),
+            "`look_at` has more than 3 values (found `2.0`)",
+        ),
+        (("LOOK", "(0.0, 1.0 0.0)"), "Expected comma, found `0.0`"),
+        (
+            ("LOOK", "(0.0, , 0.0)"),
+            "`look_at`: value 2 is missing: expected a number",
+        ),
+        // A tuple written over lines, with a comment, echoes on one line.
+        (
+            ("LOOK", "(0.0, // aim\n        1.0)"),
+            "`look_at` = (0.0, 1.0): expected 3 values, found 2",
+        ),
+        // Named fields given as bare values.
+        (
+            ("LENS", ", shutter: (0.0, 0.1)"),
+            "`shutter`: expected named fields (`name: value`) in the parentheses, found `0.0`",
+        ),
+    ];
+    for &(edit, tail) in cases {
+        let e = error(&scene(&[edit]));
+        assert!(e.ends_with(tail), "{edit:?}: {e}");
+    }
     // A whole number inside a tuple: decimal, exponent, out of range (its sign kept).
     let checker = |checks: &str| {
         let t = r#""c": Diffuse(albedo: (0.5, 0.5, 0.5), texture: "t")"#;
