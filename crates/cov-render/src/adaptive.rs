@@ -104,11 +104,17 @@ fn scale_for(sum: impl Fn(f64) -> f64, total: f64, wsum: f64) -> f64 {
     let s0 = (total / wsum).clamp(LOW, HIGH);
     let (mut a, mut b) = (s0, s0);
     let (mut fa, mut fb) = (f(a), f(b));
-    // The bracket: f(a) < 0 ≤ f(b).
+    // The bracket: f(a) < 0 ≤ f(b). `f` is nondecreasing, so where even the ends of the
+    // walk would not close it (the floors alone reach the total, or every weighted pixel
+    // at `hi` does not), the walk's answer is that end: one sum tells, instead of the
+    // walk's 250 (`a_total_the_floors_reach_takes_few_sums`).
+    if fa >= 0.0 && f(LOW) >= 0.0 {
+        return LOW;
+    }
+    if fb < 0.0 && f(HIGH) < 0.0 {
+        return HIGH;
+    }
     while fa >= 0.0 {
-        if a <= LOW {
-            return a;
-        }
         (b, fb) = (a, fa);
         a = (a / 16.0).max(LOW);
         fa = f(a);
@@ -568,6 +574,38 @@ mod tests {
                     sum(b)
                 );
             }
+        }
+    }
+    #[test]
+    fn a_total_the_floors_reach_takes_few_sums() {
+        use std::cell::Cell;
+        // A uniform first pass of 1 spp: every floor is 1 and the total is their sum. The
+        // walk down from `total / wsum` used to sum every pixel about 250 times (16 a step
+        // down to 10⁻³⁰⁰); a total beyond every weighted pixel at `hi` walked up as far.
+        let n = 1000;
+        let w: Vec<f64> = (0..n)
+            .map(|i| if i % 10 == 0 { 1.0 + i as f64 } else { 0.0 })
+            .collect();
+        let (lo, hi) = (1.0, 8.0);
+        let calls = Cell::new(0u32);
+        let sum = |s: f64| -> f64 {
+            calls.set(calls.get() + 1);
+            w.iter().map(|&v| (v * s).clamp(lo, hi)).sum()
+        };
+        let wsum: f64 = w.iter().sum();
+        let least = lo * n as f64;
+        let most = sum(1e300);
+        for (total, want) in [(least, 1e-300), (most + 1.0, 1e300)] {
+            calls.set(0);
+            assert_eq!(scale_for(sum, total, wsum), want, "total {total}");
+            assert!(calls.get() <= 3, "total {total}: {} sums", calls.get());
+        }
+        // The counts: the floors exactly, and every weighted pixel at `hi`.
+        let floors = vec![1u32; n];
+        assert_eq!(allocate_floors(&w, least, &floors, 8, false), floors);
+        let top = allocate_floors(&w, 10.0 * least, &floors, 8, false);
+        for (c, v) in top.iter().zip(&w) {
+            assert_eq!(*c, if *v > 0.0 { 8 } else { 1 });
         }
     }
 }
