@@ -43,19 +43,46 @@ fn single(v: f64) -> f32 {
     }
 }
 
-/// Writes `img` as linear OpenEXR (`.exr`) and a tone-mapped sRGB PNG beside it.
+/// How covtrace encodes OpenEXR files: exr's fast lossless encoding (run-length
+/// encoded tiles of 64×64 px), with the tiles stored in increasing order. exr compresses
+/// tiles in parallel; in an unspecified order it stores each as it is done, so the same
+/// image gave different files from run to run (the same pixels, other bytes). In
+/// increasing order it sorts them first: the same image is the same file, at any thread
+/// count (`an_exr_is_the_same_file_every_time`).
+pub const EXR_ENCODING: exr::image::Encoding = exr::image::Encoding {
+    line_order: exr::meta::attribute::LineOrder::Increasing,
+    ..exr::image::Encoding::FAST_LOSSLESS
+};
+
+/// Pixel `p` of `img` in single precision ([`single`]).
+fn rgb_at(img: &Image, p: exr::math::Vec2<usize>) -> (f32, f32, f32) {
+    let v = img.pixels[p.y() * img.width as usize + p.x()];
+    (single(v.x), single(v.y), single(v.z))
+}
+
+/// Writes `img` as linear OpenEXR (`.exr`, channels `R`, `G`, `B` in 32-bit float,
+/// [`EXR_ENCODING`]) and a tone-mapped sRGB PNG beside it.
 ///
 /// # Errors
 /// The files cannot be written.
 pub fn write_image(img: &Image, exr: &Path, png: &Path) -> Result<(), RenderError> {
-    let raw: Vec<f32> = img
-        .pixels
-        .iter()
-        .flat_map(|p| [p.x, p.y, p.z].map(single))
-        .collect();
-    let hdr = image::Rgb32FImage::from_raw(img.width, img.height, raw)
-        .ok_or_else(|| RenderError::file(exr, "the image's pixels do not match its size"))?;
-    save(hdr, exr)?;
+    use exr::prelude::*;
+    let (w, h) = (img.width as usize, img.height as usize);
+    if w == 0 || h == 0 || img.pixels.len() != w * h {
+        return Err(RenderError::file(exr, "the image's pixels do not match its size"));
+    }
+    let layer = Layer::new(
+        (w, h),
+        LayerAttributes::default(),
+        EXR_ENCODING,
+        SpecificChannels::rgb(|p| rgb_at(img, p)),
+    );
+    let mut bytes = std::io::Cursor::new(Vec::new());
+    Image::from_layer(layer)
+        .write()
+        .to_buffered(&mut bytes)
+        .map_err(|e| RenderError::file(exr, e))?;
+    write_file(exr, bytes.get_ref())?;
     save(tonemap(img), png)
 }
 
@@ -203,19 +230,15 @@ pub fn write_aovs(aovs: &Aovs, path: &Path) -> Result<(), RenderError> {
     use exr::prelude::*;
     let (w, h) = (aovs.albedo.width as usize, aovs.albedo.height as usize);
     let mut bytes = std::io::Cursor::new(Vec::new());
-    fn at(img: &crate::film::Image, p: exr::math::Vec2<usize>) -> (f32, f32, f32) {
-        let v = img.pixels[p.y() * img.width as usize + p.x()];
-        (single(v.x), single(v.y), single(v.z))
-    }
-    let layer = |name: &str| (LayerAttributes::named(name), Encoding::FAST_LOSSLESS);
+    let layer = |name: &str| (LayerAttributes::named(name), EXR_ENCODING);
     let (na, ea) = layer("albedo");
-    let albedo = Layer::new((w, h), na, ea, SpecificChannels::rgb(|p| at(&aovs.albedo, p)));
+    let albedo = Layer::new((w, h), na, ea, SpecificChannels::rgb(|p| rgb_at(&aovs.albedo, p)));
     let (nn, en) = layer("normal");
-    let normal = Layer::new((w, h), nn, en, SpecificChannels::rgb(|p| at(&aovs.normal, p)));
+    let normal = Layer::new((w, h), nn, en, SpecificChannels::rgb(|p| rgb_at(&aovs.normal, p)));
     let depth = Layer::new(
         (w, h),
         LayerAttributes::named("depth"),
-        Encoding::FAST_LOSSLESS,
+        EXR_ENCODING,
         SpecificChannels::build()
             .with_channel("Z")
             .with_pixel_fn(|p: Vec2<usize>| (single(aovs.depth[p.y() * w + p.x()]),)),
@@ -239,6 +262,39 @@ mod tests {
         assert_eq!(super::single(1e300), f32::MAX);
         assert_eq!(super::single(f64::NEG_INFINITY), -f32::MAX);
         assert_eq!(super::single(f64::NAN), 0.0);
+    }
+
+    /// The same image is the same file, byte for byte, however exr's threads finish its
+    /// tiles; and it reads back as written.
+    #[test]
+    fn an_exr_is_the_same_file_every_time() {
+        let (w, h) = (300u32, 200u32);
+        let img = crate::film::Image {
+            width: w,
+            height: h,
+            pixels: (0..w * h)
+                .map(|i| {
+                    let t = f64::from(i);
+                    glam::DVec3::new((t * 0.37).sin().abs() * 3.0, (t * 0.011).cos().abs(), t / 6e4)
+                })
+                .collect(),
+        };
+        let dir = std::env::temp_dir().join(format!("covtrace-exr-test-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let files: Vec<Vec<u8>> = (0..8)
+            .map(|k| {
+                let (exr, png) = (dir.join(format!("{k}.exr")), dir.join(format!("{k}.png")));
+                super::write_image(&img, &exr, &png).unwrap();
+                std::fs::read(&exr).unwrap()
+            })
+            .collect();
+        assert!(files.iter().all(|f| f == &files[0]), "the files differ");
+        let back = super::read_image(&dir.join("0.exr")).unwrap();
+        assert_eq!((back.width, back.height), (w, h));
+        for (a, b) in back.pixels.iter().zip(&img.pixels) {
+            assert_eq!(*a, b.as_vec3().as_dvec3());
+        }
+        std::fs::remove_dir_all(&dir).unwrap();
     }
 
     /// A write that fails says so with the system's reason (not an encoder's "decoding"),

@@ -487,7 +487,7 @@ impl PartFilm {
             Layer::new(
                 (w, rows),
                 a,
-                Encoding::FAST_LOSSLESS,
+                crate::output::EXR_ENCODING,
                 AnyChannels::sort(SmallVec::from_vec(channels)),
             )
         };
