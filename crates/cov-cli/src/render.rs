@@ -239,14 +239,19 @@ pub fn parse_size(s: &str) -> Result<(u32, u32), String> {
 /// The files a render writes, from the EXR's path `out.exr`: `out.png`, `out.density.png`,
 /// `out.filter.png`, `out.cov.json`, and the feature images `out.aov.exr`.
 pub fn outputs(exr: &Path) -> [PathBuf; 5] {
-    let stem = exr.with_extension("");
-    let s = stem.display().to_string();
+    // The stem as the system has it (not as text, which would turn a byte that is not
+    // UTF-8 into U+FFFD and write these files under another name than the image).
+    let with = |suffix: &str| {
+        let mut s = exr.with_extension("").into_os_string();
+        s.push(suffix);
+        PathBuf::from(s)
+    };
     [
         exr.with_extension("png"),
-        PathBuf::from(format!("{s}.density.png")),
-        PathBuf::from(format!("{s}.filter.png")),
-        PathBuf::from(format!("{s}.cov.json")),
-        PathBuf::from(format!("{s}.aov.exr")),
+        with(".density.png"),
+        with(".filter.png"),
+        with(".cov.json"),
+        with(".aov.exr"),
     ]
 }
 
@@ -443,6 +448,12 @@ pub fn run(a: &RenderArgs) -> Result<String, String> {
                 return Err(format!(
                     "--frames {first}..{last}: {which} out of range: must be {expected}"
                 ));
+            }
+            // No frame's outputs over an input (the scene, its textures and meshes, the
+            // same for every frame), also checked before any frame is rendered.
+            let inputs = read_by(&a.scene, &world);
+            for k in first..=last {
+                not_an_input(&written(&frame_path(&a.output, k)), &inputs, "-o")?;
             }
             // One scene, retimed for each frame; each frame's report printed as it is
             // done, the last one returned.

@@ -216,7 +216,8 @@ fn render_check_needs_tiles() {
 }
 
 /// No command writes over what it reads: a scene's texture under `render -o`, the scene
-/// itself through a file written beside the image or through a hard link, a path file
+/// itself through a file written beside the image, through a hard link or through a later
+/// frame's outputs (checked before the first frame), a path file
 /// under `plot -o`, a scene under `render-check --json`, and a scene in render-bench's
 /// output folder. One line, exit code 2, and the input unchanged.
 #[test]
@@ -236,6 +237,7 @@ fn outputs_never_overwrite_inputs() {
     }
     let d = |f: &str| dir.join(f).to_str().expect("utf-8").to_string();
     std::fs::copy(dir.join("cornell.ron"), dir.join("scene.cov.json")).expect("copy");
+    std::fs::copy(dir.join("cornell.ron"), dir.join("f.0001.cov.json")).expect("copy");
     std::fs::hard_link(dir.join("cornell.ron"), dir.join("linked.exr")).expect("link");
     std::fs::copy(
         std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/paths/brdf.ron"),
@@ -257,6 +259,7 @@ fn outputs_never_overwrite_inputs() {
         dir.join("cornell.ron"),
         dir.join("demo.png"),
         dir.join("rb/results.csv"),
+        dir.join("f.0001.cov.json"),
     ];
     let read = || -> Vec<Vec<u8>> { inputs.iter().map(|p| std::fs::read(p).expect("input")).collect() };
     let before = read();
@@ -270,6 +273,15 @@ fn outputs_never_overwrite_inputs() {
         ],
         vec!["render".into(), d("scene.cov.json"), "-o".into(), d("scene.exr")],
         vec!["render".into(), d("cornell.ron"), "-o".into(), d("linked.exr")],
+        // Frame 1's outputs include the scene: refused before frame 0 is rendered.
+        vec![
+            "render".into(),
+            d("f.0001.cov.json"),
+            "--frames".into(),
+            "0..1".into(),
+            "-o".into(),
+            d("f.exr"),
+        ],
         vec!["plot".into(), d("demo.png"), "-o".into(), d("demo.png")],
         vec![
             "render-bench".into(),
@@ -286,7 +298,7 @@ fn outputs_never_overwrite_inputs() {
     ];
     for (k, run) in runs.iter().enumerate() {
         let mut args: Vec<&str> = run.iter().map(String::as_str).collect();
-        if k < 3 {
+        if k < 4 {
             args.extend(small);
         }
         let o = covtrace(&args);
@@ -298,6 +310,7 @@ fn outputs_never_overwrite_inputs() {
         );
     }
     assert!(before == read(), "an input changed");
+    assert!(!dir.join("f.0000.exr").exists(), "frame 0 was rendered");
 }
 
 /// A file name with a line break in it is shown escaped: the error stays one line.
@@ -313,4 +326,52 @@ fn a_line_break_in_a_path_stays_escaped() {
         assert_eq!(err.trim_end().lines().count(), 1, "{err}");
         assert!(err.contains("no\\nsuch"), "{err}");
     }
+}
+
+/// An output name that is not UTF-8 names every file the render writes, byte for byte:
+/// the feature images, the maps and the JSON came out under a name with U+FFFD instead.
+#[cfg(unix)]
+#[test]
+fn an_output_name_that_is_not_utf8_names_every_output() {
+    use std::ffi::OsStr;
+    use std::os::unix::ffi::OsStrExt;
+    let dir = common::tmp("hostile-utf8", "");
+    std::fs::create_dir_all(&dir).expect("dir");
+    let stem = OsStr::from_bytes(b"bad\xffout");
+    let mut exr = stem.to_os_string();
+    exr.push(".exr");
+    let o = Command::new(env!("CARGO_BIN_EXE_covtrace"))
+        .current_dir(std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../.."))
+        .args([
+            "render",
+            "examples/scenes/cornell.ron",
+            "--size",
+            "32x24",
+            "--spp",
+            "2",
+            "-o",
+        ])
+        .arg(dir.join(&exr))
+        .output()
+        .expect("run covtrace");
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let mut names: Vec<Vec<u8>> = std::fs::read_dir(&dir)
+        .expect("dir")
+        .flatten()
+        .map(|e| e.file_name().as_bytes().to_vec())
+        .collect();
+    names.sort();
+    let want: Vec<Vec<u8>> = [
+        ".aov.exr",
+        ".cov.json",
+        ".density.png",
+        ".exr",
+        ".filter.png",
+        ".png",
+    ]
+    .iter()
+    .map(|s| [b"bad\xffout".as_slice(), s.as_bytes()].concat())
+    .collect();
+    assert_eq!(names, want);
+    std::fs::remove_dir_all(&dir).expect("clean up");
 }
