@@ -1328,7 +1328,7 @@ fn load_obj(path: &Path, limit: usize) -> Result<Obj, String> {
             }
             // The reader checked every index against the file's vertices.
             let bad = || {
-                let what = "a vertex (`v`) has a coordinate that is not a finite number";
+                let what = "a vertex (`v`) has a coordinate that is not a finite 32-bit number (NaN, inf, or past ±3.4e38: OBJ coordinates are read in single precision)";
                 match first_infinite_vertex(&text) {
                     Some(line) => format!("line {line}: {what}"),
                     None => what.to_string(),

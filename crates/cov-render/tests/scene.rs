@@ -572,7 +572,7 @@ fn obj_files_say_what_is_wrong_with_them() {
     let dir = std::env::temp_dir().join(format!("covtrace-obj-test-{}", std::process::id()));
     std::fs::create_dir_all(&dir).expect("temp dir");
     let tri = "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n";
-    let cases: [(&str, Vec<u8>, &str, &str); 15] = [
+    let cases: [(&str, Vec<u8>, &str, &str); 16] = [
         ("bom.obj", [&b"\xef\xbb\xbf"[..], tri.as_bytes()].concat(), "", ""),
         (
             "latin1.obj",
@@ -651,7 +651,13 @@ fn obj_files_say_what_is_wrong_with_them() {
             "nan.obj",
             b"# a NaN on the file's third line\nv 0 0 0\nv 1 nan 0\nv 0 1 0\nf 1 2 3\n".to_vec(),
             "",
-            "line 3: a vertex (`v`) has a coordinate that is not a finite number",
+            "line 3: a vertex (`v`) has a coordinate that is not a finite 32-bit number",
+        ),
+        (
+            "e39.obj",
+            b"v 0 0 0\nv 1 0 0\nv 1e39 1 0\nf 1 2 3\n".to_vec(),
+            "",
+            "line 3: a vertex (`v`) has a coordinate that is not a finite 32-bit number (NaN, inf, or past ±3.4e38",
         ),
         (
             "line.obj",
