@@ -1063,13 +1063,15 @@ fn within_reach(prims: &[Prim], from: usize, t0: f64, t1: f64, ordinal: u32) -> 
     if reach <= MAX_COORD {
         return Ok(());
     }
-    Err((
-        ordinal,
-        format!(
-            "this shape reaches {} m from the origin (over the shutter, if it moves): the renderer's single-precision BVH holds ±{MAX_COORD:e} m",
-            cov_core::approx(reach)
-        ),
-    ))
+    Err((ordinal, beyond_reach(reach)))
+}
+
+/// What [`within_reach`] says of a shape that reaches `reach` m from the origin.
+fn beyond_reach(reach: f64) -> String {
+    format!(
+        "this shape reaches {} m from the origin (over the shutter, if it moves): the renderer's single-precision BVH holds ±{MAX_COORD:e} m",
+        cov_core::approx(reach)
+    )
 }
 
 /// How many primitives hold each bounding box so far ([`MAX_SHARED_BOX`]).
@@ -1212,6 +1214,12 @@ fn shapes(
                     .fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(lo, hi), &q| {
                         (lo.min(q), hi.max(q))
                     });
+                // Placed out of reach, it is said so (its size would be judged against the
+                // least size out there instead, which says nothing of the `translate`).
+                let far = lo.abs().max(hi.abs()).max_element();
+                if far > MAX_COORD {
+                    return Err((obj.ordinal, beyond_reach(far)));
+                }
                 let (size, least) = (
                     (hi - lo).max_element(),
                     crate::geometry::min_size(0.5 * (lo + hi)),

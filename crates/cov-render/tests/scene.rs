@@ -718,6 +718,23 @@ fn a_mesh_placed_twice_is_read_once_and_placed_twice() {
     assert_eq!(three.inputs.len(), 1);
 }
 
+/// A mesh placed out of reach is said to be out of reach, as a sphere is, not too small
+/// for where it is.
+#[test]
+fn a_mesh_placed_out_of_reach_says_so() {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/scenes");
+    for x in ["1e13", "1e300"] {
+        let shape = format!(r#"Mesh(obj: "torus.obj", material: "w", translate: ({x}, 0.0, 0.0))"#);
+        let e = World::from_text(&scene(&[("SHAPE", &shape)]), "s.ron", &dir)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains(&format!("this shape reaches {x} m from the origin")) && e.contains("holds ±1e12 m"),
+            "{e}"
+        );
+    }
+}
+
 /// Copies of one shape in one place are refused at the first past the limit, before the
 /// BVH builder, whose time grows as the square of their number; a few copies load.
 #[test]
