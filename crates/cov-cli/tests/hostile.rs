@@ -375,3 +375,24 @@ fn an_output_name_that_is_not_utf8_names_every_output() {
     assert_eq!(names, want);
     std::fs::remove_dir_all(&dir).expect("clean up");
 }
+
+/// A default `filter` that overflows because the pixel pitch is tiny names the pitch and
+/// where it comes from, not the filter alone.
+#[test]
+fn a_tiny_pixel_pitch_is_named_where_the_filter_overflows() {
+    let path = common::tmp("hostile-pitch", "sensor.ron");
+    std::fs::write(
+        &path,
+        "Path(source: Gaussian(x: 0.1, y: 0.1), operators: [Travel(distance: 1.0), Sensor(width: 100, fov_x: 1e-300)])\n",
+    )
+    .expect("write");
+    let o = covtrace(&["eval", path.to_str().expect("utf-8")]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(
+        err.contains(":1:107: Sensor: parameter `filter` = 0.5")
+            && err.contains("pixel pitch of 1e-302 m (from distance, fov_x and width)")
+            && err.trim_end().lines().count() == 1,
+        "{err}"
+    );
+}

@@ -17,12 +17,16 @@ impl Build for SensorParams {
                 ),
             ));
         }
-        // The pixel filter's window, reported on the user's `filter` when it overflows.
+        // The pixel filter's window, `filter` pixels of the pitch: reported on the user's
+        // `filter` when it overflows, with the pitch that `distance`, `fov_x` and `width`
+        // give (a default `filter` with a tiny `fov_x` overflows too).
         let s = p.filter * pitch;
         if !(1.0 / (FOUR_PI_SQ * s * s)).is_finite() {
             return Err(SensorParams::FILTER.error(
                 p.filter,
-                "too small: the pixel filter's spectrum variance overflows f64",
+                format!(
+                    "too small for a pixel pitch of {pitch:e} m (from distance, fov_x and width): the pixel filter's spectrum variance overflows f64"
+                ),
             ));
         }
         Ok(Sensor { p, pitch })
