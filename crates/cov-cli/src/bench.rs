@@ -91,7 +91,7 @@ pub struct BenchArgs {
     /// Output folder (created with its missing parents).
     #[arg(short, long, default_value = "render-bench")]
     pub output: PathBuf,
-    /// Folder of cached references (default: the output folder).
+    /// Folder of cached references, each with its digest (default: the output folder).
     #[arg(long)]
     pub cache: Option<PathBuf>,
     /// Renders each run this many times with different seeds: errors are averaged, the
@@ -251,10 +251,31 @@ fn cached(a: &BenchArgs, world: &World, cache: &Path) -> (PathBuf, Option<cov_re
         0xcbf2_9ce4_8422_2325,
     );
     let exr = cache.join(format!("reference-{key:016x}.exr"));
-    let img = read_image(&exr)
-        .ok()
-        .filter(|img| (img.width, img.height) == (w, h) && img.pixels.iter().all(|p| p.is_finite()));
+    // Sound: its size, finite pixels, and the digest written beside it when it was
+    // rendered (a damaged file that still decodes, a byte flipped in a tile, is rendered
+    // again rather than measured against).
+    let img = read_image(&exr).ok().filter(|img| {
+        (img.width, img.height) == (w, h)
+            && img.pixels.iter().all(|p| p.is_finite())
+            && std::fs::read_to_string(digest_path(&exr)).is_ok_and(|d| d.trim() == pixel_digest(img))
+    });
     (exr, img)
+}
+
+/// The file beside a cached reference `exr` that holds its [`pixel_digest`].
+fn digest_path(exr: &Path) -> PathBuf {
+    exr.with_extension("digest")
+}
+
+/// FNV-1a (64 bits, hex) of an image's pixels as its EXR stores them (32-bit floats).
+fn pixel_digest(img: &cov_render::Image) -> String {
+    let bytes: Vec<u8> = img
+        .pixels
+        .iter()
+        .flat_map(|p| [p.x, p.y, p.z])
+        .flat_map(|v| (v as f32).to_le_bytes())
+        .collect();
+    format!("{:016x}", fnv(&bytes, 0xcbf2_9ce4_8422_2325))
 }
 
 /// The reference image: the cached one (`cached`), else rendered and cached as `exr`.
@@ -276,11 +297,21 @@ fn reference(
     let (img, secs) = timed(|| Renderer::new(world, settings)?.render(Some(&|| b.inc(1))));
     b.finish_and_clear();
     let img = img.map_err(|e| e.to_string())?.image;
+    // A cache file there that was not sound (`cached`): said, as it is replaced.
+    let again = if exr.exists() {
+        " (the cached file was damaged or had no digest: rendered again)"
+    } else {
+        ""
+    };
     write_image(&img, &exr, &exr.with_extension("png")).map_err(|e| e.to_string())?;
+    // The digest of what the file holds, as it reads back.
+    let back = read_image(&exr).map_err(|e| e.to_string())?;
+    cov_render::output::write_file(&digest_path(&exr), pixel_digest(&back).as_bytes())
+        .map_err(|e| e.to_string())?;
     Ok((
         img,
         format!(
-            "reference: {} spp in {secs:.1} s, cached as {}",
+            "reference: {} spp in {secs:.1} s, cached as {}{again}",
             a.ref_spp,
             exr.display()
         ),

@@ -59,6 +59,31 @@ fn a_tiny_bench_writes_every_output_and_caches_its_reference() {
     let again = covtrace(&args);
     assert!(again.status.success());
     assert!(String::from_utf8_lossy(&again.stdout).contains("(cached)"));
+    // A byte flipped in the cached file's last tile: it still decodes, with other pixels,
+    // and its digest tells; the reference is rendered again, and said to be.
+    let exr = std::fs::read_dir(&dir)
+        .expect("out")
+        .flatten()
+        .map(|e| e.path())
+        .find(|p| {
+            p.extension().is_some_and(|x| x == "exr")
+                && p.file_name()
+                    .is_some_and(|n| n.to_string_lossy().starts_with("reference-"))
+        })
+        .expect("the cached reference");
+    let mut bytes = std::fs::read(&exr).expect("read");
+    let k = bytes.len() - 100;
+    bytes[k] ^= 0x5a;
+    std::fs::write(&exr, &bytes).expect("write");
+    let third = covtrace(&args);
+    let out = String::from_utf8_lossy(&third.stdout);
+    assert!(third.status.success());
+    assert!(
+        !out.contains("(cached)") && out.contains("damaged or had no digest: rendered again"),
+        "{out}"
+    );
+    let fourth = covtrace(&args);
+    assert!(String::from_utf8_lossy(&fourth.stdout).contains("(cached)"));
 }
 
 #[test]
