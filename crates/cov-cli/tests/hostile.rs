@@ -396,3 +396,51 @@ fn a_tiny_pixel_pitch_is_named_where_the_filter_overflows() {
         "{err}"
     );
 }
+
+/// A scene of more mesh triangles than the process may hold (here `ulimit -v`, as a job's
+/// limit would be) is refused at the placement that passes it, in one line, instead of
+/// aborting when an allocation fails.
+#[cfg(target_os = "linux")]
+#[test]
+fn meshes_past_the_process_memory_are_refused_where_they_pass_it() {
+    let dir = common::tmp("hostile-meshes", "");
+    let scenes = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/scenes");
+    std::fs::copy(scenes.join("torus.obj"), dir.join("torus.obj")).expect("copy");
+    // 300 placements of 2,304 triangles: 0.69 GB at 1000 bytes a triangle.
+    let shapes: Vec<String> = (0..300)
+        .map(|i| {
+            format!(
+                r#"Mesh(obj: "torus.obj", material: "w", translate: ({}.0, 0.0, {}.0))"#,
+                (i % 50) * 2,
+                -(i / 50) * 2 - 3
+            )
+        })
+        .collect();
+    let scene = format!(
+        "Scene(camera: (position: (0.0, 1.0, 3.9), look_at: (0.0, 0.9, 0.0), fov: 40.0, width: 32, height: 24), \
+         materials: {{\"w\": Diffuse(albedo: (0.7, 0.7, 0.7))}}, \
+         lights: [Rect(corner: (-0.25, 5.0, -0.25), edge_u: (0.5, 0.0, 0.0), edge_v: (0.0, 0.0, 0.5), radiance: (1.0, 1.0, 1.0))], \
+         shapes: [\n{}\n])\n",
+        shapes.join(",\n")
+    );
+    std::fs::write(dir.join("meshes.ron"), scene).expect("write");
+    let o = Command::new("sh")
+        .arg("-c")
+        .arg(format!(
+            "ulimit -v 500000 && exec '{}' render meshes.ron --spp 1 --method uniform -o out.exr",
+            env!("CARGO_BIN_EXE_covtrace")
+        ))
+        .current_dir(&dir)
+        .output()
+        .expect("run covtrace under ulimit");
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(
+        err.starts_with("covtrace: meshes.ron:")
+            && err.contains("triangles, which need about")
+            && err.contains("GB are available to this process")
+            && err.trim_end().lines().count() == 1,
+        "{err}"
+    );
+    std::fs::remove_dir_all(&dir).expect("clean up");
+}
