@@ -39,6 +39,7 @@
 //! | [`denoise`] | Intel Open Image Denoise after reconstruction (feature `oidn`) |
 //! | [`metrics`], [`mod@bench`] | image error against a reference; error against time |
 //! | [`output`], [`validate`] | files written; the maps checked against reference images |
+//! | [`memory`] | the memory a render may take (machine, `ulimit -v`, the job's cgroup) |
 //!
 //! Errors are [`RenderError`]s (scene errors are positioned [`SceneError`]s), one line each.
 
@@ -53,6 +54,7 @@ pub mod film;
 pub mod geometry;
 pub mod guard;
 pub mod material;
+pub mod memory;
 pub mod metrics;
 pub mod output;
 pub mod parts;

@@ -1120,7 +1120,7 @@ fn shapes(
     let mut any_velocity = false;
     // What the meshes may take: checked as they are placed, so that a scene of many
     // placements that the process cannot hold is refused, not aborted half way.
-    let memory = crate::renderer::available_memory();
+    let memory = crate::memory::available_memory();
     // Each OBJ file is read once, however many meshes place it.
     let mut read: HashMap<std::path::PathBuf, Obj> = HashMap::new();
     for s in &desc.shapes {
