@@ -21,6 +21,9 @@ struct Cli {
     command: Command,
 }
 
+// A negative number given to an option (`--spp -1`) is read as its value, so that the
+// option's own check names it; clap would otherwise take it for an unknown flag and advise
+// `-- -1`, which does not work either.
 #[derive(Subcommand)]
 enum Command {
     /// Trace a RON path: Σ after every step.
@@ -56,21 +59,26 @@ enum Command {
     List,
     /// Check the covariance pass against a reference render: the local spectrum of each
     /// 16×16 tile against the predicted bandwidth.
+    #[command(allow_negative_numbers = true)]
     RenderCheck(crate::render::CheckArgs),
     /// Render a scene (RON) with covariance tracing (by default; --method picks another
     /// method): the covariance pass, samples where it predicts detail, per-pixel filters
     /// from Σ; writes the image (EXR and PNG) and, when the pass runs, the density and
     /// filter maps.
+    #[command(allow_negative_numbers = true)]
     Render(crate::render::RenderArgs),
     /// Merge the parts of a render (`covtrace render --part I/N`) into its image: the
     /// single-process render's, bit for bit; writes what `render` writes.
+    #[command(allow_negative_numbers = true)]
     Merge(crate::render::MergeArgs),
     /// Image error against run time: every sampling and reconstruction method (uniform,
     /// Gaussian, variance-driven, covariance-driven) at several budgets against a cached
     /// reference; writes CSV/JSON, the error-time chart and an equal-time strip.
+    #[command(allow_negative_numbers = true)]
     RenderBench(crate::bench::BenchArgs),
     /// The stiff suite: extreme chains in both forms and plain f64 against a
     /// double-double reference.
+    #[command(allow_negative_numbers = true)]
     Stiff {
         /// Length of the long chains: 4 to 1,000,000 operators, rounded down to whole
         /// bounces of four.

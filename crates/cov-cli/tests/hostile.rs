@@ -444,3 +444,35 @@ fn meshes_past_the_process_memory_are_refused_where_they_pass_it() {
     );
     std::fs::remove_dir_all(&dir).expect("clean up");
 }
+
+/// A negative number given to an option is that option's bad value, named, in one line:
+/// clap took it for an unknown flag and advised `-- -1`, which does not work either.
+#[test]
+fn a_negative_number_is_the_options_bad_value() {
+    for (args, want) in [
+        (
+            vec!["render", "examples/scenes/cornell.ron", "--spp", "-1"],
+            "invalid value '-1' for '--spp <SPP>'",
+        ),
+        (
+            vec!["render", "examples/scenes/cornell.ron", "--time", "-1"],
+            "--time must be more than 0",
+        ),
+        (
+            vec!["render-bench", "examples/scenes/cornell.ron", "--repeat", "-1"],
+            "invalid value '-1' for '--repeat <REPEAT>'",
+        ),
+        (
+            vec!["stiff", "--length", "-5"],
+            "invalid value '-5' for '--length <LENGTH>'",
+        ),
+    ] {
+        let o = covtrace(&args);
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "{args:?}: {err}");
+        assert!(
+            err.contains(want) && !err.contains("-- -") && err.trim_end().lines().count() == 1,
+            "{args:?}: {err}"
+        );
+    }
+}
