@@ -925,19 +925,15 @@ mod tests {
         assert!(check_memory(8192, 8192, Method::Uniform, Some(20_000_000_000)).is_ok());
         assert!(check_memory(256, 192, Method::Cov, Some(100_000_000)).is_ok());
         assert!(check_memory(8192, 8192, Method::Cov, None).is_ok());
-    }
-
-    /// Only covariance tracing followed by a denoiser, with no pilot and no time limit,
-    /// leaves Σ unread.
-    #[test]
-    fn a_render_past_a_limit_is_refused_in_one_line() {
-        // With the memory the limit leaves, a large render is refused in one line.
+        // With the memory a process limit leaves (`ulimit -v 600000`), in one line.
         let e = check_memory(4096, 4096, Method::Uniform, Some(600_000 * 1024))
             .unwrap_err()
             .to_string();
         assert!(e.contains("4096x4096") && !e.contains('\n'), "{e}");
     }
 
+    /// Only covariance tracing followed by a denoiser, with no pilot and no time limit,
+    /// leaves Σ unread.
     #[test]
     fn what_reads_the_covariance_pass() {
         let (cov, oidn, none) = (Method::Cov, Denoise::Oidn, Denoise::None);
