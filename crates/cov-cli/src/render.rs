@@ -794,8 +794,21 @@ pub fn check(a: &CheckArgs) -> Result<String, String> {
         max_luminance,
         ..RenderSettings::default()
     };
+    // The covariance pass's renderer first: its settings are checked before any
+    // reference is rendered.
+    let mut renderer = Renderer::new(
+        &world,
+        RenderSettings {
+            cov_paths: a.cov_paths,
+            cov_stride: 1,
+            cov_depth: a.cov_depth,
+            seed: a.seed,
+            ..RenderSettings::default()
+        },
+    )
+    .map_err(said)?;
     let render = |s: RenderSettings, b: &ProgressBar| -> Result<cov_render::Image, String> {
-        let mut r = Renderer::new(&world, s).map_err(|e| e.to_string())?;
+        let mut r = Renderer::new(&world, s).map_err(said)?;
         Ok(r.render(Some(&|| b.inc(1))).map_err(|e| e.to_string())?.image)
     };
     // Two independent references (other seeds): their cross-spectrum has no noise term.
@@ -819,17 +832,6 @@ pub fn check(a: &CheckArgs) -> Result<String, String> {
     let (ref_a, ref_b) = (refs.0?, refs.1?);
     // The maps at one prediction per pixel (the finest grid), `cov_paths` paths each.
     let b = bar(tiles, "covariance");
-    let mut renderer = Renderer::new(
-        &world,
-        RenderSettings {
-            cov_paths: a.cov_paths,
-            cov_stride: 1,
-            cov_depth: a.cov_depth,
-            seed: a.seed,
-            ..RenderSettings::default()
-        },
-    )
-    .map_err(|e| e.to_string())?;
     let (maps, t_cov) = timed(|| renderer.trace_covariance(Some(&|| b.inc(1))).cloned());
     b.finish_and_clear();
     let maps = maps.map_err(|e| e.to_string())?;

@@ -10,7 +10,7 @@ use cov_render::adaptive::Guide;
 use cov_render::covpass::covariance_rows;
 use cov_render::film::Film;
 use cov_render::guard::{candidates, chosen_filters, guarded};
-use cov_render::{MAX_DEPTH, World, covariance_maps, render};
+use cov_render::{World, covariance_maps, render};
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 
 const W: u32 = 64;
@@ -42,8 +42,8 @@ fn scenes(c: &mut Criterion) {
         g.bench_function("path tracing, 1 spp, 1 thread (elements = camera samples)", |b| {
             b.iter(|| pool.install(|| black_box(render(&world, 1, 1))))
         });
-        // The pass's cost per depth (surface vertices per path).
-        for depth in 1..=MAX_DEPTH {
+        // The pass's cost per depth (surface vertices per path, up to the scene's).
+        for depth in 1..=world.max_depth {
             g.bench_function(
                 format!("covariance pass, 1 path per pixel, depth {depth}, 1 thread (elements = paths)"),
                 |b| {

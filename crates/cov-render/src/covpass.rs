@@ -1,6 +1,6 @@
 //! The covariance pass: for each pixel, a few covariance paths that follow the path
-//! tracer's paths (camera → x₁ → light, camera → x₁ → x₂ → light; up to [`MAX_DEPTH`]
-//! surface vertices), each vertex's direct light turned into an operator chain of the
+//! tracer's paths (camera → x₁ → light, camera → x₁ → x₂ → light, …; up to the scene's
+//! `max_depth` surface vertices), each vertex's direct light turned into an operator chain of the
 //! library (light source, travel, blocker edge, reflection at each vertex back to the
 //! camera, motion, lens, shutter), evaluated, and reduced to the sensor's per-pixel
 //! decisions (cov-sensor). Every vertex's chain is weighted by the radiance it carries to
@@ -19,8 +19,8 @@
 //!    the material's lobe, and the turn from the plane of incidence to the plane of the
 //!    outgoing ray; then the change of handedness and the texture), inside `Moving` when
 //!    the shape moves;
-//! 4. for a second vertex (`depth` 2; the renderer's default is [`DEFAULT_DEPTH`], one),
-//!    travel back along the path to the first, with a `BlockerEdge` where probes from the
+//! 4. for a later vertex (`depth` 2 or more; the renderer's default is [`DEFAULT_DEPTH`],
+//!    one), travel back along the path to the vertex before, with a `BlockerEdge` where probes from the
 //!    first vertex at its lobe's angular width see an outline beside the segment, and the
 //!    reflection there, as in 3 (glossy inter-reflection: a glossy floor mirroring what
 //!    stands on it, the outline blurred by the floor's lobe);
@@ -268,10 +268,11 @@ fn texture_window(
     Ok(Some(Texture::new(w[0], w[1].clamp(-bound, bound), w[2])?))
 }
 
-/// Surface vertices a covariance path follows at most: those of the path tracer's paths
-/// (camera → x₁ → light and camera → x₁ → x₂ → light, crate::trace). A deeper vertex
-/// would predict light the image does not have.
-pub const MAX_DEPTH: u32 = 2;
+/// Surface vertices a covariance path follows at most: those of the deepest path tracer
+/// a scene can ask for ([`crate::scene::MAX_PATH_DEPTH`]). A render's covariance paths
+/// follow at most its scene's own depth ([`World::max_depth`]): a deeper vertex would
+/// predict light the image does not have.
+pub const MAX_DEPTH: u32 = crate::scene::MAX_PATH_DEPTH;
 
 /// Surface vertices a covariance path follows unless told otherwise: 1 (camera → x₁ →
 /// light). Measured, not chosen: following the second vertex as well made `cov` worse on
@@ -1003,7 +1004,7 @@ pub fn covariance_maps(
 /// the `parts` module); the other pixels keep [`PixelCov::default`]. Each tile draws from
 /// its own generator, seeded by its index in the whole image, so a tile's values are the
 /// same whichever rows are traced. Paths follow at most `depth` surface vertices (1 to
-/// [`MAX_DEPTH`]; 1 traces camera → hit → light only).
+/// the scene's [`World::max_depth`]; 1 traces camera → hit → light only).
 ///
 /// # Errors
 /// As [`covariance_maps`], and `depth` out of range.
@@ -1031,10 +1032,13 @@ pub fn covariance_rows(
             paths,
         ));
     }
-    if !(1..=MAX_DEPTH).contains(&depth) {
+    if !(1..=world.max_depth.min(MAX_DEPTH)).contains(&depth) {
         return Err(crate::RenderError::setting(
             "the covariance paths' depth",
-            format!("1 to {MAX_DEPTH}"),
+            format!(
+                "1 to the scene's max_depth, {} (the path tracer's vertices)",
+                world.max_depth.min(MAX_DEPTH)
+            ),
             depth,
         ));
     }

@@ -461,13 +461,21 @@ impl Geometry {
         best.map(|(t, id)| self.prims[id].hit(o, d, t, time))
     }
 
-    /// Whether anything lies on the ray in `(tmin, tmax)` at `time`.
-    pub fn occluded(&self, o: DVec3, d: DVec3, time: f64, tmin: f64, tmax: f64) -> bool {
+    /// Whether anything lies on the ray in `(tmin, tmax)` at `time`; the primitives of
+    /// light `except` are not looked at (a shadow ray towards a point sampled on that
+    /// light: an emitter is convex, so nothing of it lies before the point, and a ray that
+    /// grazes its outline would otherwise find it there by rounding, which darkened a
+    /// sphere light's direct light by 0.6% at a radius of 0.3 of its distance; the test
+    /// `a_furnace_of_any_depth_matches_its_closed_form`).
+    pub fn occluded(&self, o: DVec3, d: DVec3, time: f64, tmin: f64, tmax: f64, except: Option<u32>) -> bool {
         if self.prims.is_empty() {
             return false;
         }
         let ray = Ray::new(v3a(o), v3a(d), tmin as f32, tmax.min(f32::MAX as f64) as f32);
         !self.bvh.ray_traverse_miss(ray, |_, id| {
+            if except.is_some() && self.prims[id].light == except {
+                return f32::INFINITY;
+            }
             match self.prims[id].intersect(o, d, time, tmin, tmax) {
                 Some(t) => t as f32,
                 None => f32::INFINITY,

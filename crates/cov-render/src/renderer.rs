@@ -161,8 +161,9 @@ pub struct RenderSettings {
     pub cov_paths: u32,
     /// Side of the covariance grid's blocks (px, one of [`STRIDES`]).
     pub cov_stride: u32,
-    /// Surface vertices a covariance path follows (1 to [`MAX_DEPTH`], the path
-    /// tracer's; 1, [`DEFAULT_DEPTH`]: camera → hit → light only).
+    /// Surface vertices a covariance path follows (1 to the scene's
+    /// [`World::max_depth`], the path tracer's, at most [`MAX_DEPTH`]; 1,
+    /// [`DEFAULT_DEPTH`]: camera → hit → light only).
     pub cov_depth: u32,
     /// Every sample's luminance is clamped to this (colour scaled down); `∞` for an
     /// unbiased image. A finite clamp is biased: for measuring the spectrum of a reference
@@ -301,6 +302,16 @@ impl<'w> Renderer<'w> {
     /// has tile rows ([`part_rows`]).
     pub fn new(world: &'w World, settings: RenderSettings) -> Result<Renderer<'w>, RenderError> {
         settings.check()?;
+        if settings.cov_depth > world.max_depth {
+            return Err(RenderError::setting(
+                "cov_depth",
+                format!(
+                    "1 to the scene's max_depth, {} (a covariance path follows the path tracer's vertices)",
+                    world.max_depth
+                ),
+                settings.cov_depth,
+            ));
+        }
         part_rows(world.camera.height, 1, settings.parts)?;
         let (w, h) = (world.camera.width, world.camera.height);
         check_memory(w, h, settings.method, available_memory())?;

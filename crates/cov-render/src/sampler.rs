@@ -18,10 +18,14 @@ pub trait Sampler {
 /// Largest sample index the sequence supports (`sobol_burley` has 2¹⁶ points).
 pub const MAX_INDEX: u32 = 1 << 16;
 
-/// Number of pairs one sample may use: the path tracer uses at most 16 dimensions; a
-/// sample that asks for more gets pairs with wrapped seeds (still uniform, no longer
-/// independent of the first ones, which never happens with this tracer).
-const PAIRS: u32 = 64;
+/// Number of pairs one sample may use. The path tracer uses 5 dimensions for the camera
+/// ray and at most 6 per surface vertex (the light's choice and point, the next direction,
+/// Russian roulette), 6 d + 4 in all at depth `d`: 196 at the deepest scene
+/// (the scene file's largest `max_depth`, 32), within these 256. A sample that asked for more
+/// would get pairs with wrapped seeds (still uniform, no longer independent of the first
+/// ones), which this tracer never does. Pairs below 64 have the seeds they had when this
+/// was 64.
+const PAIRS: u32 = 128;
 
 /// The padded Owen-scrambled Sobol sampler of one pixel.
 #[derive(Clone, Debug)]

@@ -26,6 +26,7 @@
 //!
 //! | field | unit | meaning |
 //! |---|---|---|
+//! | `max_depth` | vertices | the path tracer's depth, as pbrt-v4's `maxdepth`: the surface vertices at which a path takes direct light, 1 (direct light only) to [`MAX_PATH_DEPTH`] (32); default [`DEFAULT_PATH_DEPTH`] (2, one indirect bounce); Russian roulette from the third vertex |
 //! | `camera.position`, `look_at`, `up` | m | pinhole / lens centre, aim point (both within ±[`crate::geometry::MAX_COORD`]), up vector (default +y) |
 //! | `camera.fov` | degrees | horizontal field of view, from [`MIN_FOV`] (1e-6) to below 180 |
 //! | `camera.width`, `height` | px | 1 to [`MAX_RESOLUTION`] each |
@@ -192,10 +193,41 @@ impl<'de> Deserialize<'de> for Resolution {
     }
 }
 
+/// Longest path the tracer follows: surface vertices at which a path takes direct light
+/// (`max_depth`). Each vertex takes six random numbers (the light's choice and point, the
+/// next direction, Russian roulette), so a path of this depth stays within the sampler's
+/// independent dimensions ([`crate::sampler`]).
+pub const MAX_PATH_DEPTH: u32 = 32;
+
+/// The tracer's depth when the scene does not give `max_depth`: direct light at the first
+/// two vertices (camera → x₁ → light and camera → x₁ → x₂ → light), one indirect bounce.
+pub const DEFAULT_PATH_DEPTH: u32 = 2;
+
+/// A path's depth, 1 to [`MAX_PATH_DEPTH`] ([`SceneFile::max_depth`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PathDepth(pub u32);
+
+impl<'de> Deserialize<'de> for PathDepth {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        let v = u64::deserialize(d)?;
+        if (1..=u64::from(MAX_PATH_DEPTH)).contains(&v) {
+            Ok(PathDepth(v as u32))
+        } else {
+            Err(D::Error::custom(format!(
+                "must be 1 to {MAX_PATH_DEPTH} surface vertices, got {v}"
+            )))
+        }
+    }
+}
+
 /// The whole file, written `Scene(...)`.
 #[derive(Clone, Debug, Deserialize)]
 #[serde(deny_unknown_fields, rename = "Scene")]
 pub struct SceneFile {
+    /// The path tracer's depth: the surface vertices at which a path takes direct light,
+    /// as pbrt-v4's `maxdepth` (1: direct light only; default [`DEFAULT_PATH_DEPTH`]).
+    #[serde(default)]
+    pub max_depth: Option<PathDepth>,
     /// The camera.
     pub camera: CameraDesc,
     /// Named textures (materials refer to them by name), each name once.

@@ -1,10 +1,12 @@
 //! The path tracer: direct lighting from area lights (light and BRDF sampling combined by
-//! multiple importance sampling) and one indirect bounce, over pixel × lens × time. At the
-//! second vertex, light sampling alone where the material is diffuse, and both
-//! strategies combined where it is glossy (the function `second_vertex` says why).
+//! multiple importance sampling) at every surface vertex of a path, up to the scene's
+//! `max_depth` (default 2: one indirect bounce), over pixel × lens × time. At the last
+//! vertex, light sampling alone where the material is diffuse, and both strategies
+//! combined where it is glossy (the function `reflected` says why).
 //!
-//! The estimator is unbiased for the transport it includes: paths of one and two bounces
-//! (camera → x₁ → light, camera → x₁ → x₂ → light) and lights seen directly.
+//! The estimator is unbiased for the transport it includes: paths of 1 to `max_depth`
+//! surface vertices (camera → x₁ → light, camera → x₁ → x₂ → light, …) and lights seen
+//! directly.
 
 use crate::sampler::Sampler;
 use glam::DVec3;
@@ -64,7 +66,8 @@ fn direct<S: Sampler + ?Sized>(
 ) -> DVec3 {
     let n_lights = world.lights.len();
     let pick = (rng.next() * n_lights as f64) as usize;
-    let light = &world.lights[pick.min(n_lights - 1)];
+    let pick = pick.min(n_lights - 1);
+    let light = &world.lights[pick];
     let Some(ls) = light.sample(hit.p, rng.next(), rng.next()) else {
         return DVec3::ZERO;
     };
@@ -76,7 +79,7 @@ fn direct<S: Sampler + ?Sized>(
     let o = spawn(hit, ls.wi);
     if world
         .geometry
-        .occluded(o, ls.wi, time, 0.0, ls.dist * (1.0 - 1e-6))
+        .occluded(o, ls.wi, time, 0.0, ls.dist * (1.0 - 1e-6), Some(pick as u32))
     {
         return DVec3::ZERO;
     }
@@ -155,7 +158,18 @@ pub fn radiance_parts<S: Sampler + ?Sized>(world: &World, ray: &CameraRay, rng: 
     }
 }
 
-/// The light the surface at `hit` reflects towards the camera.
+/// The light the surface at `hit` reflects towards the camera: direct light at each of
+/// the path's surface vertices, up to the scene's depth ([`World::max_depth`]).
+///
+/// At every vertex but the last, light sampling is weighed against the BRDF sample that
+/// continues the path (multiple importance sampling). At the last vertex a lobe narrower
+/// than the lights (a glossy ball reflecting a lamp onto the floor) makes light sampling
+/// alone fire rare bright samples, the lobe's peak over the light sample's density: there
+/// a BRDF sample joins it, the two weighed as at the others. A diffuse last vertex, whose
+/// BRDF sample seldom finds a light while its ray costs as much as the light's, takes
+/// light sampling alone, unbiased on its own. From the third vertex on, a path continues
+/// with the probability of its throughput's largest channel (at most 1) and is divided by
+/// it (Russian roulette, unbiased); the first two vertices are always taken.
 fn reflected<S: Sampler + ?Sized>(
     world: &World,
     ray: &CameraRay,
@@ -163,46 +177,49 @@ fn reflected<S: Sampler + ?Sized>(
     mat: &Material,
     rng: &mut S,
 ) -> DVec3 {
-    let wo = -ray.dir;
-    let mut l = direct(world, hit, mat, wo, ray.time, rng, true);
-    // One indirect bounce, by BRDF sampling.
-    let Some(b) = bounce(world, hit, mat, wo, ray.time, rng) else {
-        return l;
-    };
-    match b.hit.light {
-        // A light found by BRDF sampling: the other half of the MIS pair.
-        Some(_) => l += b.emission(world, hit),
-        None => {
-            let mat2 = world.material_at(&b.hit, footprint(world, hit.t + b.hit.t));
-            l += b.throughput * second_vertex(world, &b.hit, &mat2, -b.wi, ray.time, rng);
+    let depth = world.max_depth.max(1);
+    let (mut l, mut beta) = (DVec3::ZERO, DVec3::ONE);
+    let (mut v, mut mat, mut wo, mut dist) = (*hit, *mat, -ray.dir, hit.t);
+    for k in 1..=depth {
+        let last = k == depth;
+        let both = !last || !matches!(mat, Material::Diffuse { .. });
+        // This vertex's light, summed before the throughput multiplies it.
+        let mut here = direct(world, &v, &mat, wo, ray.time, rng, both);
+        let next = if both {
+            bounce(world, &v, &mat, wo, ray.time, rng)
+        } else {
+            None
+        };
+        let Some(b) = next else {
+            l += beta * here;
+            break;
+        };
+        if last || b.hit.light.is_some() {
+            // A light found by BRDF sampling: the other half of the MIS pair.
+            here += b.emission(world, &v);
+            l += beta * here;
+            break;
         }
+        l += beta * here;
+        beta *= b.throughput;
+        if k + 1 >= ROULETTE_FROM {
+            let q = beta.max_element().min(1.0);
+            if q.is_nan() || rng.next() >= q {
+                break;
+            }
+            beta /= q;
+        }
+        dist += b.hit.t;
+        mat = world.material_at(&b.hit, footprint(world, dist));
+        (v, wo) = (b.hit, -b.wi);
     }
     l
 }
 
-/// The direct light the second vertex `hit` (material `mat`) reflects along `wo`, the
-/// path's last vertex.
-///
-/// A lobe narrower than the lights (a glossy ball reflecting a lamp onto the floor) makes
-/// light sampling alone fire rare bright samples, the lobe's peak over the light sample's
-/// density: there a BRDF sample joins it, the two weighed by multiple importance sampling
-/// as at the first vertex. A diffuse vertex, whose BRDF sample seldom finds a light while
-/// its ray costs as much as the light's, takes light sampling alone, unbiased on its own.
-fn second_vertex<S: Sampler + ?Sized>(
-    world: &World,
-    hit: &Hit,
-    mat: &Material,
-    wo: DVec3,
-    time: f64,
-    rng: &mut S,
-) -> DVec3 {
-    let both = !matches!(mat, Material::Diffuse { .. });
-    let mut l = direct(world, hit, mat, wo, time, rng, both);
-    if both && let Some(b) = bounce(world, hit, mat, wo, time, rng) {
-        l += b.emission(world, hit);
-    }
-    l
-}
+/// The first vertex at which a path may end by Russian roulette ([`reflected`]): the
+/// third, so that paths of the default depth (2) take no roulette number and keep their
+/// sampler dimensions.
+const ROULETTE_FROM: u32 = 3;
 
 /// A direction drawn from a material's lobe and what the ray along it hits.
 struct Bounce {
@@ -310,17 +327,29 @@ mod tests {
         (m, (s2 / f64::from(n) - m * m).max(0.0))
     }
 
+    /// The light a path's last vertex `hit` reflects along `wo`: [`reflected`] in a world
+    /// of depth 1, where the first vertex is the last.
+    fn last_vertex(world: &mut World, hit: &Hit, mat: &Material, wo: DVec3, rng: &mut Uniform) -> DVec3 {
+        world.max_depth = 1;
+        let ray = CameraRay {
+            origin: hit.p + wo,
+            dir: -wo,
+            time: 0.0,
+        };
+        reflected(world, &ray, hit, mat, rng)
+    }
+
     /// A Phong-300 floor at 45° to a 1 m lamp that fills its lobe (a glossy ball's
-    /// reflection of a lamp, as the felt sees it in the snooker scene): the second
+    /// reflection of a lamp, as the felt sees it in the snooker scene): the last
     /// vertex's estimate agrees with light sampling alone (the estimator before the two
     /// were combined) and with BRDF sampling alone, within 4σ, and its variance is a
     /// fraction of light sampling's.
     #[test]
-    fn a_glossy_second_vertex_combines_light_and_brdf_sampling() {
-        let (world, hit, mat, wo) = floor_under_lamp("Phong(albedo: (0.8, 0.8, 0.8), exponent: 300.0)");
+    fn a_glossy_last_vertex_combines_light_and_brdf_sampling() {
+        let (mut world, hit, mat, wo) = floor_under_lamp("Phong(albedo: (0.8, 0.8, 0.8), exponent: 300.0)");
         let mut rng = Uniform(rand_chacha::ChaCha8Rng::seed_from_u64(7));
         let n = 40_000;
-        let combined = moments(n, || second_vertex(&world, &hit, &mat, wo, 0.0, &mut rng).y);
+        let combined = moments(n, || last_vertex(&mut world, &hit, &mat, wo, &mut rng).y);
         let light = moments(n, || direct(&world, &hit, &mat, wo, 0.0, &mut rng, false).y);
         let brdf = moments(n, || {
             bounce(&world, &hit, &mat, wo, 0.0, &mut rng)
@@ -343,17 +372,17 @@ mod tests {
         );
     }
 
-    /// A diffuse second vertex takes light sampling alone: the same numbers as `direct`
+    /// A diffuse last vertex takes light sampling alone: the same numbers as `direct`
     /// without its MIS weight, drawn from the same generator.
     #[test]
-    fn a_diffuse_second_vertex_samples_the_light_alone() {
-        let (world, hit, mat, wo) = floor_under_lamp("Diffuse(albedo: (0.5, 0.5, 0.5))");
+    fn a_diffuse_last_vertex_samples_the_light_alone() {
+        let (mut world, hit, mat, wo) = floor_under_lamp("Diffuse(albedo: (0.5, 0.5, 0.5))");
         let (mut a, mut b) = (
             Uniform(rand_chacha::ChaCha8Rng::seed_from_u64(3)),
             Uniform(rand_chacha::ChaCha8Rng::seed_from_u64(3)),
         );
         for _ in 0..64 {
-            let got = second_vertex(&world, &hit, &mat, wo, 0.0, &mut a);
+            let got = last_vertex(&mut world, &hit, &mat, wo, &mut a);
             assert_eq!(got, direct(&world, &hit, &mat, wo, 0.0, &mut b, false));
         }
     }

@@ -310,6 +310,9 @@ pub struct World {
     /// The files the scene reads besides itself (image textures, OBJ meshes), as
     /// resolved from its folder.
     pub inputs: Vec<std::path::PathBuf>,
+    /// The path tracer's depth: surface vertices at which a path takes direct light (the
+    /// scene's `max_depth`, 1 to [`crate::scene::MAX_PATH_DEPTH`]).
+    pub max_depth: u32,
     /// Whether anything moves during an open shutter (the covariance is then traced with
     /// a time axis, layout 5; else layout 4).
     pub has_motion: bool,
@@ -484,6 +487,7 @@ impl World {
             fingerprint: fingerprint(text, &inputs),
             inputs,
             frame: 0,
+            max_depth: desc.max_depth.map_or(crate::scene::DEFAULT_PATH_DEPTH, |d| d.0),
             has_motion: camera.shutter.is_some() && any_velocity,
             camera,
             materials,

@@ -219,7 +219,7 @@ fn bad_parts_are_refused_with_one_line() {
     let mut huge = ps[0].clone();
     huge.key.spp = 1e308;
     let mut deep = ps[0].clone();
-    deep.key.cov_depth = 9;
+    deep.key.cov_depth = 33;
     let mut late = ps[0].clone();
     late.key.frame = u32::MAX;
     let mut slow = ps[0].clone();
@@ -229,7 +229,7 @@ fn bad_parts_are_refused_with_one_line() {
             huge,
             "a damaged part key: spp must be 1 to 65536 samples per pixel",
         ),
-        (deep, "a damaged part key: cov_depth must be 1 to 2"),
+        (deep, "a damaged part key: cov_depth must be 1 to 32"),
         (late, "a damaged part key: frame 4294967295; at most 1000000"),
         (slow, "a damaged part header: timing"),
     ] {

@@ -81,6 +81,86 @@ fn a_diffuse_plane_under_a_sphere_light_matches_the_closed_form() {
     );
 }
 
+/// Inside a diffuse sphere of radius `R` and albedo ρ, lit by a sphere light of radius `r`
+/// and radiance `L` at its centre, every point of the wall takes `E₀ = π L s` from the
+/// light directly (`s = (r/R)²`, the light's share of the projected solid angle) and sees
+/// the rest of the wall, of one radiosity by symmetry, over `1 − s` of it: each bounce
+/// multiplies the irradiance by `ρ (1 − s)`. A path of `d` surface vertices
+/// (`max_depth: d`) therefore sees `ρ L s Σ_{k<d} (ρ (1 − s))ᵏ`. The tracer must match it
+/// at depths 1, 2 (the default: no `max_depth` written), 5 and 32 (Russian roulette from
+/// the third vertex) within 4σ, each depth's sum at least 8σ from its neighbours' (so the
+/// depth is the one asked for).
+#[test]
+fn a_furnace_of_any_depth_matches_its_closed_form() {
+    let (albedo, radiance, r) = (0.5f64, 100.0f64, 0.1f64);
+    let s = r * r;
+    let exact =
+        |d: u32| albedo * radiance * s * (0..d).map(|k| (albedo * (1.0 - s)).powi(k as i32)).sum::<f64>();
+    for depth in [None, Some(1u32), Some(5), Some(32)] {
+        let field = depth.map_or(String::new(), |d| format!("max_depth: {d},"));
+        let text = format!(
+            r#"Scene(
+            {field}
+            camera: (position: (0.0, 0.0, 0.5), look_at: (0.0, 0.0, 1.0), fov: 10.0, width: 1, height: 1),
+            materials: {{ "wall": Diffuse(albedo: ({albedo:?}, {albedo:?}, {albedo:?})) }},
+            lights: [Sphere(center: (0.0, 0.0, 0.0), radius: {r:?}, radiance: ({radiance:?}, {radiance:?}, {radiance:?}))],
+            shapes: [Sphere(center: (0.0, 0.0, 0.0), radius: 1.0, material: "wall")],
+        )"#
+        );
+        let world = World::from_text(&text, "<furnace>", Path::new(".")).unwrap_or_else(|e| panic!("{e}"));
+        let d = depth.unwrap_or(2);
+        assert_eq!(world.max_depth, d);
+        let n = 60_000u32;
+        let mut film = Film::new(1, 1);
+        film.render(&world, &[n], 9, f64::INFINITY, None);
+        let got = film.box_image().pixels[0].y;
+        let stderr = (film.variance()[0] / f64::from(n)).sqrt();
+        assert!(
+            stderr > 0.0 && (got - exact(d)).abs() <= 4.0 * stderr,
+            "depth {d}: got {got}, closed form {} ± {stderr}",
+            exact(d)
+        );
+        for other in [d - 1, d + 1].into_iter().filter(|&o| o >= 1 && o != d) {
+            assert!(
+                (exact(other) - exact(d)).abs() >= 8.0 * stderr || d >= 32,
+                "depth {d}: the test cannot tell it from depth {other} (σ {stderr})"
+            );
+        }
+    }
+}
+
+/// A scene of depth 4 (`max_depth: 4`, the glossy scene): its covariance paths follow up
+/// to four vertices, with finite, PSD maps that differ from one vertex's (the later
+/// vertices are seen); a fifth vertex, which its images do not have, is refused with the
+/// scene's depth named.
+#[test]
+fn covariance_paths_follow_a_deeper_scene_and_no_further() {
+    let text = std::fs::read_to_string(scenes().join("glossy.ron")).expect("glossy.ron");
+    let text = text.replacen("Scene(", "Scene(\n    max_depth: 4,", 1);
+    let world = World::from_text(&text, "glossy-4.ron", &scenes())
+        .unwrap_or_else(|e| panic!("{e}"))
+        .with_resolution(32, 24);
+    assert_eq!(world.max_depth, 4);
+    let one = cov_render::covpass::covariance_rows(&world, 2, 4, 1, 3, 0..24, None).expect("depth 1");
+    let four = cov_render::covpass::covariance_rows(&world, 2, 4, 4, 3, 0..24, None).expect("depth 4");
+    for p in &four.pixels {
+        let [a, b, c] = p.sigma;
+        assert!(
+            a.is_finite() && b.is_finite() && c.is_finite() && p.spp.is_finite(),
+            "{p:?}"
+        );
+        assert!(
+            a >= 0.0 && c >= 0.0 && b * b <= a * c * (1.0 + 1e-9) + 1e-300,
+            "{p:?}"
+        );
+    }
+    assert_ne!(one, four, "the later vertices change the maps");
+    let e = cov_render::covpass::covariance_rows(&world, 2, 4, 5, 3, 0..24, None)
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("must be 1 to the scene's max_depth, 4"), "{e}");
+}
+
 /// Adaptive counts and a second pass that continues each pixel's sequence keep the box
 /// estimate unbiased: a diffuse plane under a sphere light (closed form `ρ L (R/D)²`, as above) estimated from 3 001 then 9 000 more samples matches within 4σ.
 #[test]

@@ -473,6 +473,26 @@ fn small_inputs_cannot_ask_for_unbounded_work() {
     );
 }
 
+/// A path's depth is a count the user controls: 1 to 32, refused where it is written,
+/// 2 when left out.
+#[test]
+fn a_path_depth_is_bounded_where_it_is_written() {
+    let at = |d: &str| BASE.replace("Scene(\n", &format!("Scene(\n    max_depth: {d},\n"));
+    for (d, want) in [
+        ("0", "2:16: `max_depth` must be 1 to 32 surface vertices, got 0"),
+        ("33", "2:16: `max_depth` must be 1 to 32 surface vertices, got 33"),
+        ("-1", "2:17: `max_depth` = -1 is out of range for a whole number"),
+        ("2.5", "2:17: `max_depth` = 2.5: expected a whole number"),
+    ] {
+        let e = error(&scene_from(&at(d)));
+        assert!(e.starts_with(want), "max_depth {d}: {e}");
+    }
+    let deep = World::from_text(&scene_from(&at("32")), "s.ron", Path::new(".")).expect("32 is allowed");
+    assert_eq!(deep.max_depth, 32);
+    let plain = World::from_text(&scene(&[]), "s.ron", Path::new(".")).expect("the base scene");
+    assert_eq!(plain.max_depth, cov_render::scene::DEFAULT_PATH_DEPTH);
+}
+
 /// A syntax error says what stands where something else was expected: the word or the
 /// character there, or the end of the line.
 #[test]
