@@ -48,7 +48,8 @@ pub struct RenderArgs {
     #[arg(long, default_value_t = 4)]
     pub cov_stride: u32,
     /// Surface vertices each covariance path follows: 1 (camera → hit → light; the
-    /// default, measured better) to 2 (every vertex the path tracer samples).
+    /// default, measured better) to the scene's `max_depth` (every vertex the path tracer
+    /// samples; 2 unless the scene says otherwise).
     #[arg(long, default_value_t = cov_render::DEFAULT_DEPTH, value_parser = clap::value_parser!(u32).range(1..=i64::from(cov_render::covpass::MAX_DEPTH)))]
     pub cov_depth: u32,
     /// Seed of the random numbers (the image does not depend on the thread count).
@@ -751,7 +752,8 @@ pub struct CheckArgs {
     #[arg(long, default_value_t = 8, value_parser = clap::value_parser!(u32).range(1..=i64::from(cov_render::covpass::MAX_COV_PATHS)))]
     pub cov_paths: u32,
     /// Surface vertices each covariance path follows: 1 (camera → hit → light; the
-    /// default, measured better) to 2 (every vertex the path tracer samples).
+    /// default, measured better) to the scene's `max_depth` (every vertex the path tracer
+    /// samples; 2 unless the scene says otherwise).
     #[arg(long, default_value_t = cov_render::DEFAULT_DEPTH, value_parser = clap::value_parser!(u32).range(1..=i64::from(cov_render::covpass::MAX_DEPTH)))]
     pub cov_depth: u32,
     /// Render at this size instead of the scene's (`WIDTHxHEIGHT`).

@@ -40,7 +40,7 @@
 //! | `materials` | | named `Diffuse(albedo)`, `Phong(albedo, exponent)` (exponent 0 to 1e12), `Ggx(albedo, alpha)` (alpha at least 1e-6: a narrower lobe is below what f64 resolves), each with an optional `texture` that multiplies the albedo |
 //! | `lights` | | `Rect(corner, edge_u, edge_v, radiance)`, `Sphere(center, radius, radiance)`; radiance in W/(m² sr) per channel |
 //! | `shapes` | | `Sphere(center, radius, material, velocity)`, `Quad(corner, edge_u, edge_v, material, velocity)`, `Mesh(obj, material, translate, scale, velocity)` (one material for the whole mesh: the OBJ's `mtllib` and `usemtl` lines are not read, and `usemtl` lines naming several materials are a warning: split such a file, one OBJ and one `Mesh` per material; a mesh without texture coordinates `vt` reads its material's texture at `(0, 0)`) |
-//! | colours (`albedo`, texture colours, `radiance`) | | each entry 0 to [`MAX_COLOUR`] (1e9) |
+//! | colours (`albedo`, texture colours, `radiance`) | | each entry 0 to [`MAX_COLOUR`] (1e9) as it is read; a material's `albedo` and a texture's colours at most 1 (a surface reflects no more than it receives) |
 //! | every shape and light | m | within ±[`crate::geometry::MAX_COORD`] (1e12) of the origin, with its motion over the shutter (and at every frame rendered) |
 //! | copies | | at most [`MAX_SHARED_BOX`] (256) shapes, lights and triangles lying exactly on one another (the BVH builder's time grows as the square of their number); at most [`MAX_TRIANGLES`] triangles over all meshes, each placement counted |
 //! | a sphere's radius, a quad's or rect light's edges, a mesh's extent | m | at least [`crate::geometry::MIN_SIZE`] × (1 m + the largest \|coordinate\| of its centre or corner) |

@@ -530,8 +530,13 @@ fn camera(c: &CameraDesc) -> Result<Camera, Failure> {
     }
     let right = forward.cross(up0);
     if right.length() <= 1e-12 {
-        let o = c.up.as_ref().map_or(c.look_at.ordinal, |u| u.ordinal);
-        return Err((o, "`up` is parallel to the viewing direction".into()));
+        return Err(match c.up.as_ref() {
+            Some(u) => (u.ordinal, "`up` is parallel to the viewing direction".into()),
+            None => (
+                c.look_at.ordinal,
+                "the camera looks straight up or down, along the default `up` (0, 1, 0): give the camera an `up` across the view, e.g. up: (0.0, 0.0, -1.0)".into(),
+            ),
+        });
     }
     let right = right.normalize();
     let up = right.cross(forward);

@@ -493,6 +493,20 @@ fn a_path_depth_is_bounded_where_it_is_written() {
     assert_eq!(plain.max_depth, cov_render::scene::DEFAULT_PATH_DEPTH);
 }
 
+/// A camera that looks straight down with no `up` written is told what to write, at its
+/// `look_at` (a new user's top-down camera read "`up` is parallel", naming a field the
+/// file did not have).
+#[test]
+fn a_top_down_camera_is_told_to_give_an_up() {
+    let e = error(&scene(&[("LOOK", "(0.0, -1.0, 3.0)")]));
+    assert!(
+        e.starts_with("2:50: the camera looks straight up or down, along the default `up` (0, 1, 0): give the camera an `up`"),
+        "{e}"
+    );
+    let e = error(&scene(&[("LOOK", "(0.0, -1.0, 3.0), up: (0.0, 2.0, 0.0)")]));
+    assert!(e.contains("`up` is parallel to the viewing direction"), "{e}");
+}
+
 /// A syntax error says what stands where something else was expected: the word or the
 /// character there, or the end of the line.
 #[test]
