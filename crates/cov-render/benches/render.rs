@@ -42,6 +42,17 @@ fn scenes(c: &mut Criterion) {
         g.bench_function("path tracing, 1 spp, 1 thread (elements = camera samples)", |b| {
             b.iter(|| pool.install(|| black_box(render(&world, 1, 1))))
         });
+        // The tracer's cost per depth (`max_depth`; the scene's own is 2, the line above).
+        if name == "cornell" {
+            for depth in [1, 3, 5, 32] {
+                let mut deep = scene(name, W, H);
+                deep.max_depth = depth;
+                g.bench_function(
+                    format!("path tracing, 1 spp, max_depth {depth}, 1 thread (elements = camera samples)"),
+                    |b| b.iter(|| pool.install(|| black_box(render(&deep, 1, 1)))),
+                );
+            }
+        }
         // The pass's cost per depth (surface vertices per path, up to the scene's).
         for depth in 1..=world.max_depth {
             g.bench_function(

@@ -330,15 +330,15 @@ pub enum MaterialDesc {
     /// Lambertian.
     Diffuse {
         /// Reflectance per channel, ≤ 1.
-        albedo: Rgb,
+        albedo: At<Rgb>,
         /// A texture from `textures` that multiplies the albedo.
         #[serde(default)]
         texture: Option<At<String>>,
     },
     /// Normalised modified Phong around the mirror direction (the cov-brdf Phong lobe).
     Phong {
-        /// Reflectance per channel.
-        albedo: Rgb,
+        /// Reflectance per channel, ≤ 1.
+        albedo: At<Rgb>,
         /// Exponent, 0 to 1e12 (`world::MIN_LOBE_WIDTH`).
         exponent: NonNegative,
         /// A texture from `textures` that multiplies the albedo.
@@ -347,8 +347,8 @@ pub enum MaterialDesc {
     },
     /// GGX microfacets (the cov-brdf GGX lobe).
     Ggx {
-        /// Reflectance per channel.
-        albedo: Rgb,
+        /// Reflectance per channel, ≤ 1.
+        albedo: At<Rgb>,
         /// Roughness, at least 1e-6 (`world::MIN_LOBE_WIDTH`).
         alpha: Positive,
         /// A texture from `textures` that multiplies the albedo.

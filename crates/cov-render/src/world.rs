@@ -836,7 +836,7 @@ fn materials(desc: &SceneFile, textures: &Names<'_>) -> Result<Materials, Failur
         let (mat, texture) = match m {
             MaterialDesc::Diffuse { albedo, texture } => (
                 Material::Diffuse {
-                    albedo: DVec3::from_array(albedo.0),
+                    albedo: DVec3::from_array(albedo.value.0),
                 },
                 texture,
             ),
@@ -846,7 +846,7 @@ fn materials(desc: &SceneFile, textures: &Names<'_>) -> Result<Materials, Failur
                 texture,
             } => (
                 Material::Phong {
-                    albedo: DVec3::from_array(albedo.0),
+                    albedo: DVec3::from_array(albedo.value.0),
                     exponent: exponent.0,
                 },
                 texture,
@@ -857,16 +857,21 @@ fn materials(desc: &SceneFile, textures: &Names<'_>) -> Result<Materials, Failur
                 texture,
             } => (
                 Material::Ggx {
-                    albedo: DVec3::from_array(albedo.0),
+                    albedo: DVec3::from_array(albedo.value.0),
                     alpha: alpha.0,
                 },
                 texture,
             ),
         };
+        let at = match m {
+            MaterialDesc::Diffuse { albedo, .. }
+            | MaterialDesc::Phong { albedo, .. }
+            | MaterialDesc::Ggx { albedo, .. } => albedo.ordinal,
+        };
         let albedo = mat.albedo();
         if albedo.max_element() > 1.0 {
             return Err((
-                name.ordinal,
+                at,
                 format!(
                     "material `{}`: an albedo above 1 reflects more than it receives",
                     crate::echo(&name.value)

@@ -85,7 +85,7 @@ fn checks_after_parsing_point_at_the_value() {
         ),
         (
             &[("MAT", r#""hot": Diffuse(albedo: (2.0, 0.5, 0.5))"#)],
-            "3:57: material `hot`: an albedo above 1",
+            "3:80: material `hot`: an albedo above 1",
         ),
         // Lobes narrower than f64 resolves directions lost their reflections unsaid.
         (
