@@ -325,9 +325,24 @@ fn reference(
 /// Bad arguments or scene, unwritable outputs.
 pub fn bench(a: &BenchArgs) -> Result<String, String> {
     let (methods, budgets) = check_args(a)?;
+    let world = crate::render::load(&a.scene, a.size)?;
+    let settings = |Variant(method, denoise): Variant, spp: f64, seed: u64| RenderSettings {
+        method,
+        spp,
+        seed,
+        denoise,
+        cov_paths: a.cov_paths,
+        cov_stride: a.cov_stride,
+        cov_depth: a.cov_depth,
+        parts: a.parts,
+        ..RenderSettings::default()
+    };
+    // The runs' settings checked against the scene (`--parts` against its rows,
+    // `--cov-depth` against its depth) before any folder is made or the reference, which
+    // may take minutes, is rendered.
+    Renderer::new(&world, settings(Variant::UNIFORM, budgets[0], 1)).map_err(crate::render::said)?;
     folder(&a.output, "output folder")?;
     let cache = a.cache.clone().unwrap_or_else(|| a.output.clone());
-    let world = crate::render::load(&a.scene, a.size)?;
     // The cache must take a new reference, unless it holds this one (it may be read-only).
     let found = cached(a, &world, &cache);
     if found.1.is_none() {
@@ -358,20 +373,6 @@ pub fn bench(a: &BenchArgs) -> Result<String, String> {
         "scene: {} ({w}×{h} px)\n",
         cov_render::echo(&a.scene.display().to_string())
     );
-    let settings = |Variant(method, denoise): Variant, spp: f64, seed: u64| RenderSettings {
-        method,
-        spp,
-        seed,
-        denoise,
-        cov_paths: a.cov_paths,
-        cov_stride: a.cov_stride,
-        cov_depth: a.cov_depth,
-        parts: a.parts,
-        ..RenderSettings::default()
-    };
-    // The runs' settings checked against the scene (`--parts` against its rows) before
-    // the reference, which may take minutes.
-    Renderer::new(&world, settings(Variant::UNIFORM, budgets[0], 1)).map_err(crate::render::said)?;
     let (reference, line) = reference(a, &world, found)?;
     out.push_str(&line);
     out.push('\n');

@@ -479,18 +479,25 @@ fn a_negative_number_is_the_options_bad_value() {
 
 /// A covariance path deeper than the scene's path tracer (`max_depth`, 2 when the scene
 /// does not say) is refused in one line by every command that traces one, before any
-/// rendering.
+/// rendering and before render-bench makes its folders.
 #[test]
 fn a_covariance_depth_past_the_scenes_is_refused() {
+    let dir = std::env::temp_dir().join(format!("covtrace-deep-{}", std::process::id()));
+    let out = dir.join("out").display().to_string();
     for cmd in ["render", "render-check", "render-bench"] {
-        let args = [cmd, "examples/scenes/cornell.ron", "--cov-depth", "3"];
+        let mut args = vec![cmd, "examples/scenes/cornell.ron", "--cov-depth", "3"];
+        if cmd == "render-bench" {
+            args.extend(["-o", out.as_str()]);
+        }
         let o = covtrace(&args);
         let err = String::from_utf8_lossy(&o.stderr);
         assert_eq!(o.status.code(), Some(2), "{args:?}: {err}");
         assert!(
-            err.contains("--cov-depth must be 1 to the scene's max_depth, 2")
-                && err.trim_end().lines().count() == 1,
+            err.contains(
+                "--cov-depth must be 1 to the scene's max_depth, 2 (2 where the scene file gives none"
+            ) && err.trim_end().lines().count() == 1,
             "{args:?}: {err}"
         );
     }
+    assert!(!dir.exists(), "render-bench made its folders before refusing");
 }

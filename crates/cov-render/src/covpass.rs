@@ -1036,7 +1036,7 @@ pub fn covariance_rows(
         return Err(crate::RenderError::setting(
             "the covariance paths' depth",
             format!(
-                "1 to the scene's max_depth, {} (the path tracer's vertices)",
+                "1 to the scene's max_depth, {} (2 where the scene file gives none; the path tracer's vertices)",
                 world.max_depth.min(MAX_DEPTH)
             ),
             depth,

@@ -306,7 +306,7 @@ impl<'w> Renderer<'w> {
             return Err(RenderError::setting(
                 "cov_depth",
                 format!(
-                    "1 to the scene's max_depth, {} (a covariance path follows the path tracer's vertices)",
+                    "1 to the scene's max_depth, {} (2 where the scene file gives none; a covariance path follows the path tracer's vertices)",
                     world.max_depth
                 ),
                 settings.cov_depth,
