@@ -538,10 +538,11 @@ fn camera_side(
     let edge = nearest_silhouette(world, hit, (px, py), block, ut, footprint);
     travel_past(&mut chain, hit.t, edge, motion, (d_out, x_out))?;
     chain.push(RotateFrame::new(turn(d_out, x_out, x_cam))?);
-    if motion && cam.velocity != DVec3::ZERO {
+    if motion && (cam.velocity != DVec3::ZERO || cam.angular_velocity != DVec3::ZERO) {
+        // A turning camera turns the direction of every ray it sees at `ω × d`.
         chain.push(CameraMotion::new(
             in_frame(cam.velocity, d_out, x_cam),
-            [0.0, 0.0],
+            in_frame(cam.angular_velocity.cross(d_out), d_out, x_cam),
         )?);
     }
     chain.push(cc.end.clone());

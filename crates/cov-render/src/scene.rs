@@ -15,6 +15,12 @@
 //! )
 //! ```
 //!
+//! What the format does not have (a user's list, 2026-12-02): rotating objects and motion other than a constant velocity, emissive
+//! materials, textured lights, point, directional and environment lights, glass and other
+//! dielectrics, per-face OBJ materials, non-uniform or mirrored mesh scale. The operator
+//! library has what the covariance pass would need for some of them (cov-refraction's
+//! Snell interfaces, cov-motion's rotations); the renderer does not yet use them.
+//!
 //! Every number is checked as it is read (finite, in range), so a bad value is reported
 //! at its own line and column; names that refer elsewhere (a material, an OBJ file) are
 //! checked after reading and reported where they are written. An OBJ file the reader
@@ -35,6 +41,7 @@
 //! | `camera.lens.focal_length` | m | focal length (default 0.05) in [`LENS_RANGE`], < focus distance |
 //! | `camera.shutter.open`, `close` | s | shutter interval, `close − open` in [`SHUTTER_RANGE`] (1e-15 to 1e6) |
 //! | `camera.velocity` | m/s | camera motion during the shutter; the camera stays within ±[`crate::geometry::MAX_COORD`] of the origin over it (and at every frame rendered) |
+//! | `camera.angular_velocity` | rad/s | camera rotation during the shutter about its lens centre: the axis times the rate (`(0.0, 0.5, 0.0)` pans left at 0.5 rad/s, turning the view from −z towards −x), at most [`MAX_ANGULAR_VELOCITY`] (2000π, a thousand turns a second) in length; with `velocity`, `ω = v/d` about the up axis tracks a point at distance `d` |
 //! | `camera.frame_rate` | 1/s | frames per second of an animation (`--frame K` moves the shutter and a still's instant by `K / frame_rate`), default 24 |
 //! | `textures` | | named `Checker(checks, a, b)`, `Stripes(count, duty, a, b)`, `Noise(cells, a, b, seed)` (generated; `size` texels per side, default 1024), `Image(file)` (PNG, sRGB, 8 or 16 bits, grey or colour, its alpha ignored; or EXR, linear, with R, G and B channels or one grey channel Y; relative to the scene file; texels clamped to 0 to 1, NaN to 0); all take `repeat: (u, v)` |
 //! | `materials` | | named `Diffuse(albedo)`, `Phong(albedo, exponent)` (exponent 0 to 1e12), `Ggx(albedo, alpha)` (alpha at least 1e-6: a narrower lobe is below what f64 resolves), each with an optional `texture` that multiplies the albedo |
@@ -193,6 +200,10 @@ impl<'de> Deserialize<'de> for Resolution {
     }
 }
 
+/// Largest camera rotation rate (rad/s, `camera.angular_velocity`): a thousand turns a
+/// second. Faster is no camera, and the covariance pass's time shears grow with it.
+pub const MAX_ANGULAR_VELOCITY: f64 = 2.0e3 * std::f64::consts::PI;
+
 /// Longest path the tracer follows: surface vertices at which a path takes direct light
 /// (`max_depth`). Each vertex takes six random numbers (the light's choice and point, the
 /// next direction, Russian roulette), so a path of this depth stays within the sampler's
@@ -295,6 +306,11 @@ pub struct CameraDesc {
     /// Camera velocity during the shutter (m/s).
     #[serde(default)]
     pub velocity: Option<At<V3>>,
+    /// Camera rotation during the shutter (rad/s): the axis times the rate, about the lens
+    /// centre; the view direction, the image's right and up turn together (a pan, a tilt,
+    /// a roll). At most [`MAX_ANGULAR_VELOCITY`] in length.
+    #[serde(default)]
+    pub angular_velocity: Option<At<V3>>,
     /// Frames per second of an animation ([`crate::World::at_frame`]); default 24.
     #[serde(default)]
     pub frame_rate: Option<Positive>,

@@ -20,7 +20,7 @@ fn v(a: V3) -> DVec3 {
     DVec3::from_array(a.0)
 }
 
-/// A thin-lens (or pinhole) camera with a shutter and a velocity.
+/// A thin-lens (or pinhole) camera with a shutter, a velocity and a rotation rate.
 #[derive(Clone, Copy, Debug)]
 pub struct Camera {
     /// Lens centre at time 0.
@@ -56,6 +56,9 @@ pub struct Camera {
     pub frame_rate: f64,
     /// Velocity (m/s).
     pub velocity: DVec3,
+    /// Rotation rate about the lens centre (rad/s, axis times rate): at time `t` the
+    /// camera's frame (forward, right, up) is turned by `ω t` ([`Camera::frame_at`]).
+    pub angular_velocity: DVec3,
 }
 
 /// A ray leaving the camera.
@@ -84,10 +87,11 @@ impl Camera {
     /// lens point `lens` (uniforms in `[0,1)²`, mapped to the disk) and the time uniform
     /// `ut`.
     pub fn ray(&self, px: f64, py: f64, lens: (f64, f64), ut: f64) -> CameraRay {
+        let time = self.time_offset + self.shutter.map_or(0.0, |(a, b)| a + (b - a) * ut);
+        let (forward, right, up) = self.frame_at(time);
         let nx = (2.0 * px / self.width as f64 - 1.0) * self.tan_x;
         let ny = (1.0 - 2.0 * py / self.height as f64) * self.tan_y;
-        let pin = (self.forward + self.right * nx + self.up * ny).normalize();
-        let time = self.time_offset + self.shutter.map_or(0.0, |(a, b)| a + (b - a) * ut);
+        let pin = (forward + right * nx + up * ny).normalize();
         let centre = self.position + self.velocity * time;
         if self.lens_radius <= 0.0 {
             return CameraRay {
@@ -96,14 +100,25 @@ impl Camera {
                 time,
             };
         }
-        let focus = centre + pin * (self.focus_distance / pin.dot(self.forward));
+        let focus = centre + pin * (self.focus_distance / pin.dot(forward));
         let (dx, dy) = concentric_disk(lens.0, lens.1);
-        let origin = centre + (self.right * dx + self.up * dy) * self.lens_radius;
+        let origin = centre + (right * dx + up * dy) * self.lens_radius;
         CameraRay {
             origin,
             dir: (focus - origin).normalize(),
             time,
         }
+    }
+
+    /// The camera's forward, right and up directions at time `time` (s): turned by
+    /// `angular_velocity · time` about the lens centre; those of time 0 when it does not
+    /// turn.
+    pub fn frame_at(&self, time: f64) -> (DVec3, DVec3, DVec3) {
+        if self.angular_velocity == DVec3::ZERO {
+            return (self.forward, self.right, self.up);
+        }
+        let q = glam::DQuat::from_scaled_axis(self.angular_velocity * time);
+        (q * self.forward, q * self.right, q * self.up)
     }
 
     /// Lens to sensor (m): the thin-lens image distance, or the focal length for a pinhole.
@@ -478,7 +493,8 @@ impl World {
             &mut warnings,
         )
         .map_err(|(o, m)| at(o, m))?
-            || camera.velocity != DVec3::ZERO;
+            || camera.velocity != DVec3::ZERO
+            || camera.angular_velocity != DVec3::ZERO;
         large_enough(&desc).map_err(|(o, m)| at(o, m))?;
         let warnings = warnings.into_iter().map(|(o, m)| at(o, m).to_string()).collect();
         let inputs = input_files(&desc, dir);
@@ -641,7 +657,21 @@ fn camera(c: &CameraDesc) -> Result<Camera, Failure> {
         time_offset: 0.0,
         frame_rate: c.frame_rate.map_or(DEFAULT_FRAME_RATE, |r| r.0),
         velocity: c.velocity.as_ref().map_or(DVec3::ZERO, |u| v(u.value)),
+        angular_velocity: c.angular_velocity.as_ref().map_or(DVec3::ZERO, |u| v(u.value)),
     };
+    if let Some(w) = &c.angular_velocity {
+        let rate = v(w.value).length();
+        if !(rate.is_finite() && rate <= crate::scene::MAX_ANGULAR_VELOCITY) {
+            return Err((
+                w.ordinal,
+                format!(
+                    "angular_velocity must be at most {} rad/s (a thousand turns a second) in length, got {}",
+                    cov_core::num(crate::scene::MAX_ANGULAR_VELOCITY),
+                    cov_core::num(rate)
+                ),
+            ));
+        }
+    }
     let (t0, t1) = camera.shutter.unwrap_or((0.0, 0.0));
     let reach = camera.reach(t0, t1);
     if reach > MAX_COORD {

@@ -161,6 +161,75 @@ fn covariance_paths_follow_a_deeper_scene_and_no_further() {
     assert!(e.contains("must be 1 to the scene's max_depth, 4"), "{e}");
 }
 
+/// A camera moving at `v` along its right while turning at `ω = v/d` about its up axis
+/// tracks the point at distance `d` ahead (docs/physics.md, motion): the tracer's ray
+/// through the image's centre meets the tracked sphere's front at the shutter's two ends
+/// (within the turn's third-order term), where moving alone it sweeps `v t` across; and the
+/// covariance pass keeps the sphere's outline as sharp as a still camera does and predicts
+/// little time content, where moving alone (or turning the wrong way) the outline is
+/// blurred and the swept bands need many samples in time.
+#[test]
+fn a_camera_that_turns_to_track_a_point_keeps_it_still() {
+    let (v, d, close) = (1.0f64, 5.0f64, 0.5f64);
+    let world = |velocity: f64, turn: f64| -> World {
+        let text = format!(
+            r#"Scene(
+            camera: (position: (0.0, 0.0, 0.0), look_at: (0.0, 0.0, -5.0), fov: 40.0, width: 32, height: 24,
+                shutter: (open: 0.0, close: {close:?}), velocity: ({velocity:?}, 0.0, 0.0), angular_velocity: (0.0, {turn:?}, 0.0)),
+            materials: {{ "grey": Diffuse(albedo: (0.5, 0.5, 0.5)), "dark": Diffuse(albedo: (0.05, 0.05, 0.05)) }},
+            lights: [Rect(corner: (-2.0, 4.0, -7.0), edge_u: (4.0, 0.0, 0.0), edge_v: (0.0, 0.0, 4.0), radiance: (5.0, 5.0, 5.0))],
+            shapes: [
+                Sphere(center: (0.0, 0.0, -{d:?}), radius: 0.8, material: "grey"),
+                Quad(corner: (-40.0, -30.0, -30.0), edge_u: (80.0, 0.0, 0.0), edge_v: (0.0, 60.0, 0.0), material: "dark"),
+            ],
+        )"#
+        );
+        World::from_text(&text, "<tracking>", Path::new(".")).unwrap_or_else(|e| panic!("{e}"))
+    };
+    let (still, tracking, moving) = (world(0.0, 0.0), world(v, v / d), world(v, 0.0));
+    // How far the ray through the image's centre passes from the tracked point.
+    let miss = |w: &World, ut: f64| {
+        let ray = w.camera.ray(16.0, 12.0, (0.5, 0.5), ut);
+        (glam::DVec3::new(0.0, 0.0, -d) - ray.origin)
+            .cross(ray.dir)
+            .length()
+    };
+    let turn = v / d * close;
+    let third = d * (turn.tan() - turn).abs();
+    for ut in [0.0, 0.5, 1.0] {
+        assert!(
+            miss(&tracking, ut) <= third + 1e-12,
+            "tracking, at {ut}: {}",
+            miss(&tracking, ut)
+        );
+    }
+    assert!(
+        (miss(&moving, 1.0) - v * close).abs() < 1e-9,
+        "{}",
+        miss(&moving, 1.0)
+    );
+    // The pass, along the sphere's row: the sharpest outline (the largest `Σxx`) and the
+    // time content (predicted samples per pixel over pixel × lens × time, above the row's
+    // least, summed in units of it: a swept band needs many).
+    let row = |w: &World| -> (f64, f64) {
+        let maps = covariance_maps(w, 4, 1, 5, None).expect("maps");
+        let px: Vec<_> = (0..32).map(|x| maps.pixels[12 * 32 + x]).collect();
+        let least = px.iter().map(|p| p.spp).fold(f64::INFINITY, f64::min);
+        let sharpest = px.iter().map(|p| p.sigma[0]).fold(0.0, f64::max);
+        (sharpest, px.iter().map(|p| p.spp / least - 1.0).sum())
+    };
+    let (still, tracking, moving, wrong) =
+        (row(&still), row(&tracking), row(&moving), row(&world(v, -v / d)));
+    assert!(
+        tracking.0 >= 0.8 * still.0 && moving.0 < 0.7 * still.0,
+        "outline: still {still:?}, tracking {tracking:?}, moving {moving:?}"
+    );
+    assert!(
+        tracking.1 < 0.25 * moving.1 && moving.1 < wrong.1,
+        "time content: still {still:?}, tracking {tracking:?}, moving {moving:?}, turning the wrong way {wrong:?}"
+    );
+}
+
 /// Adaptive counts and a second pass that continues each pixel's sequence keep the box
 /// estimate unbiased: a diffuse plane under a sphere light (closed form `ρ L (R/D)²`, as above) estimated from 3 001 then 9 000 more samples matches within 4σ.
 #[test]

@@ -493,6 +493,26 @@ fn a_path_depth_is_bounded_where_it_is_written() {
     assert_eq!(plain.max_depth, cov_render::scene::DEFAULT_PATH_DEPTH);
 }
 
+/// A camera's rotation rate is bounded where it is written.
+#[test]
+fn a_camera_turning_too_fast_is_refused_at_its_rate() {
+    let e = error(&scene(&[("LENS", ", angular_velocity: (0.0, 1e5, 0.0)")]));
+    assert!(
+        e.contains("angular_velocity must be at most 6283.185307179586 rad/s (a thousand turns a second) in length, got 100000"),
+        "{e}"
+    );
+    let ok = World::from_text(
+        &scene(&[(
+            "LENS",
+            ", shutter: (open: 0.0, close: 0.1), angular_velocity: (0.0, 0.5, 0.0)",
+        )]),
+        "s.ron",
+        Path::new("."),
+    )
+    .expect("a pan");
+    assert!(ok.has_motion, "a turning camera is motion");
+}
+
 /// A camera that looks straight down with no `up` written is told what to write, at its
 /// `look_at` (a new user's top-down camera read "`up` is parallel", naming a field the
 /// file did not have).
