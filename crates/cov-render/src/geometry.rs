@@ -26,6 +26,11 @@ pub enum Shape {
         center: DVec3,
         /// Radius.
         radius: f64,
+        /// Angular velocity about the centre (rad/s, axis times rate): the surface, its
+        /// texture coordinates with it, is turned by `spin · t` at time `t`. The shape is
+        /// the same at every angle, so only the coordinates and the points' velocities
+        /// (`velocity + spin × (p − centre)`) see it.
+        spin: DVec3,
     },
     /// A triangle, with optional vertex normals and texture coordinates.
     Triangle {
@@ -280,7 +285,7 @@ impl Prim {
     fn bounds_at(&self, t: f64) -> (DVec3, DVec3) {
         let off = self.velocity * t;
         match self.shape {
-            Shape::Sphere { center, radius } => (
+            Shape::Sphere { center, radius, .. } => (
                 center + off - DVec3::splat(radius),
                 center + off + DVec3::splat(radius),
             ),
@@ -309,7 +314,7 @@ impl Prim {
     fn intersect(&self, o: DVec3, d: DVec3, time: f64, tmin: f64, tmax: f64) -> Option<f64> {
         let o = o - self.velocity * time;
         match self.shape {
-            Shape::Sphere { center, radius } => {
+            Shape::Sphere { center, radius, .. } => {
                 let oc = o - center;
                 let b = oc.dot(d);
                 let c = oc.length_squared() - radius * radius;
@@ -350,19 +355,32 @@ impl Prim {
         let p = o + d * t;
         // The point at rest (shapes move rigidly: their coordinates move with them).
         let q = p - self.velocity * time;
+        let mut velocity = self.velocity;
         let (n_out, ns_out, curvature, uv, dpduv) = match self.shape {
-            Shape::Sphere { center, radius } => {
+            Shape::Sphere { center, radius, spin } => {
                 let n = (q - center) / radius;
+                // The surface's own direction of the point: turned back by the spin.
+                let (turn, m) = if spin == DVec3::ZERO {
+                    (None, n)
+                } else {
+                    velocity += spin.cross(q - center);
+                    let turn = glam::DQuat::from_scaled_axis(spin * time);
+                    (Some(turn), turn.inverse() * n)
+                };
                 // Longitude u from +x towards −z, latitude v from the south pole (−y): seen
                 // from outside, u runs to the right and v up (∂p/∂u × ∂p/∂v points out of
                 // the sphere), so an image reads as it does on a quad, not mirrored.
-                let phi = (-n.z).atan2(n.x);
-                let theta = n.y.clamp(-1.0, 1.0).acos();
+                let phi = (-m.z).atan2(m.x);
+                let theta = m.y.clamp(-1.0, 1.0).acos();
                 let (sp, cp, st, ct) = (phi.sin(), phi.cos(), theta.sin(), theta.cos());
                 let uv = DVec2::new(0.5 + phi / (2.0 * PI), 1.0 - theta / PI);
                 let dpdu = DVec3::new(-st * sp, 0.0, -st * cp) * (2.0 * PI * radius);
                 let dpdv = -DVec3::new(ct * cp, -st, -ct * sp) * (PI * radius);
-                (n, n, Bend::isotropic(1.0 / radius, n), uv, [dpdu, dpdv])
+                let dpduv = match turn {
+                    Some(r) => [r * dpdu, r * dpdv],
+                    None => [dpdu, dpdv],
+                };
+                (n, n, Bend::isotropic(1.0 / radius, n), uv, dpduv)
             }
             Shape::Triangle { v, n, uv, bend } => {
                 let (e1, e2) = (v[1] - v[0], v[2] - v[0]);
@@ -401,7 +419,7 @@ impl Prim {
             ng,
             front,
             curvature: if front { curvature } else { curvature.flipped() },
-            velocity: self.velocity,
+            velocity,
             material: self.material,
             light: self.light,
             uv,
@@ -505,7 +523,11 @@ mod tests {
     fn a_sphere_texture_is_not_mirrored() {
         let (c, r) = (DVec3::new(0.3, -0.2, 0.5), 0.7);
         let prim = Prim {
-            shape: Shape::Sphere { center: c, radius: r },
+            shape: Shape::Sphere {
+                center: c,
+                radius: r,
+                spin: DVec3::ZERO,
+            },
             velocity: DVec3::ZERO,
             material: 0,
             light: None,

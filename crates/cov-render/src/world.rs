@@ -1019,6 +1019,7 @@ fn lights(desc: &SceneFile, prims: &mut Vec<Prim>) -> Result<Vec<Light>, Failure
                     shape: Shape::Sphere {
                         center: v(*center),
                         radius: radius.0,
+                        spin: DVec3::ZERO,
                     },
                     velocity: DVec3::ZERO,
                     material: u32::MAX,
@@ -1190,10 +1191,28 @@ fn shapes(
             })
         };
         match s {
-            ShapeDesc::Sphere { center, radius, .. } => push(Shape::Sphere {
-                center: v(*center),
-                radius: radius.value.0,
-            }),
+            ShapeDesc::Sphere {
+                center, radius, spin, ..
+            } => {
+                if let Some(w) = spin {
+                    let rate = v(w.value).length();
+                    if !(rate.is_finite() && rate <= crate::scene::MAX_ANGULAR_VELOCITY) {
+                        return Err((
+                            w.ordinal,
+                            format!(
+                                "spin must be at most {} rad/s (a thousand turns a second) in length, got {}",
+                                cov_core::num(crate::scene::MAX_ANGULAR_VELOCITY),
+                                cov_core::num(rate)
+                            ),
+                        ));
+                    }
+                }
+                push(Shape::Sphere {
+                    center: v(*center),
+                    radius: radius.value.0,
+                    spin: spin.as_ref().map_or(DVec3::ZERO, |w| v(w.value)),
+                })
+            }
             ShapeDesc::Quad {
                 corner,
                 edge_u,

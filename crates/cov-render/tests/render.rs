@@ -230,6 +230,117 @@ fn a_camera_that_turns_to_track_a_point_keeps_it_still() {
     );
 }
 
+/// A sphere spinning about `y` at `w` carries its surface with it: the point that faces
+/// `+z` at time 0 faces `+x` a quarter turn later, with the same texture coordinates and
+/// derivatives turned with it. Rolling without slipping (`spin = up × v / r`), the point
+/// touching the floor is still and the top moves at twice the ball's velocity (what the
+/// covariance pass's motion reads).
+#[test]
+fn a_spinning_sphere_carries_its_surface() {
+    let text = |spin: &str, velocity: &str| {
+        format!(
+            r#"Scene(
+            camera: (position: (0.0, 0.0, 5.0), look_at: (0.0, 0.0, 0.0), fov: 30.0, width: 8, height: 8, shutter: (open: 0.0, close: 1.0)),
+            materials: {{ "grey": Diffuse(albedo: (0.5, 0.5, 0.5)) }},
+            lights: [Rect(corner: (-1.0, 4.0, -1.0), edge_u: (2.0, 0.0, 0.0), edge_v: (0.0, 0.0, 2.0), radiance: (5.0, 5.0, 5.0))],
+            shapes: [Sphere(center: (0.0, 0.0, 0.0), radius: 0.5, material: "grey", velocity: {velocity}, spin: {spin})],
+        )"#
+        )
+    };
+    let w = 2.0f64;
+    let world = World::from_text(
+        &text(&format!("(0.0, {w:?}, 0.0)"), "(0.0, 0.0, 0.0)"),
+        "<spin>",
+        Path::new("."),
+    )
+    .unwrap_or_else(|e| panic!("{e}"));
+    let quarter = std::f64::consts::FRAC_PI_2 / w;
+    let from_z = world
+        .geometry
+        .intersect(
+            glam::DVec3::new(0.0, 0.0, 3.0),
+            -glam::DVec3::Z,
+            0.0,
+            0.0,
+            f64::INFINITY,
+        )
+        .expect("front at 0");
+    let from_x = world
+        .geometry
+        .intersect(
+            glam::DVec3::new(3.0, 0.0, 0.0),
+            -glam::DVec3::X,
+            quarter,
+            0.0,
+            f64::INFINITY,
+        )
+        .expect("side a quarter turn later");
+    assert!(
+        (from_z.uv - from_x.uv).length() < 1e-12,
+        "{:?} against {:?}",
+        from_z.uv,
+        from_x.uv
+    );
+    // ∂p/∂u turned by a quarter about y: (a, b, c) → (c, b, −a).
+    let [du0, _] = from_z.dpduv;
+    let [du1, _] = from_x.dpduv;
+    assert!(
+        (du1 - glam::DVec3::new(du0.z, du0.y, -du0.x)).length() < 1e-9 * du0.length(),
+        "{du0} {du1}"
+    );
+    // Without spin the side shows other coordinates.
+    let still = World::from_text(
+        &text("(0.0, 0.0, 0.0)", "(0.0, 0.0, 0.0)"),
+        "<still>",
+        Path::new("."),
+    )
+    .unwrap();
+    let side = still
+        .geometry
+        .intersect(
+            glam::DVec3::new(3.0, 0.0, 0.0),
+            -glam::DVec3::X,
+            quarter,
+            0.0,
+            f64::INFINITY,
+        )
+        .unwrap();
+    assert!((side.uv - from_z.uv).length() > 0.2, "{:?}", side.uv);
+    // Rolling along +x at 1 m/s on a floor facing +y: spin (0, 0, −v/r).
+    let rolling = World::from_text(
+        &text("(0.0, 0.0, -2.0)", "(1.0, 0.0, 0.0)"),
+        "<rolling>",
+        Path::new("."),
+    )
+    .unwrap();
+    let at = |o: glam::DVec3, d: glam::DVec3| {
+        rolling
+            .geometry
+            .intersect(o, d, 0.0, 0.0, f64::INFINITY)
+            .expect("the ball")
+            .velocity
+    };
+    let bottom = at(glam::DVec3::new(0.0, -3.0, 0.0), glam::DVec3::Y);
+    let top = at(glam::DVec3::new(0.0, 3.0, 0.0), -glam::DVec3::Y);
+    assert!(bottom.length() < 1e-12, "the contact point moves at {bottom}");
+    assert!(
+        (top - glam::DVec3::new(2.0, 0.0, 0.0)).length() < 1e-12,
+        "the top moves at {top}"
+    );
+    // Bounded where it is written.
+    let e = World::from_text(
+        &text("(0.0, 1e6, 0.0)", "(0.0, 0.0, 0.0)"),
+        "s.ron",
+        Path::new("."),
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(
+        e.contains("s.ron:5:118: spin must be at most 6283.185307179586 rad/s"),
+        "{e}"
+    );
+}
+
 /// Adaptive counts and a second pass that continues each pixel's sequence keep the box
 /// estimate unbiased: a diffuse plane under a sphere light (closed form `ρ L (R/D)²`, as above) estimated from 3 001 then 9 000 more samples matches within 4σ.
 #[test]
