@@ -15,9 +15,9 @@
 //! )
 //! ```
 //!
-//! What the format does not have (a user's list, 2026-12-02): rotating quads and meshes,
-//! motion other than a constant velocity and a sphere's spin, emissive materials, textured lights, point, directional and environment lights, glass and other
-//! dielectrics, per-face OBJ materials, non-uniform or mirrored mesh scale. The operator
+//! What the format does not have (a user's list, 2026-12-02): quads and meshes that turn
+//! while the shutter is open, motion other than a constant velocity and a sphere's spin, emissive materials, textured lights, point, directional and environment lights, glass and other
+//! dielectrics, per-face OBJ materials, non-uniform or mirrored mesh scale, rotating meshes. The operator
 //! library has what the covariance pass would need for some of them (cov-refraction's
 //! Snell interfaces, cov-motion's rotations); the renderer does not yet use them.
 //!
@@ -46,7 +46,7 @@
 //! | `textures` | | named `Checker(checks, a, b)`, `Stripes(count, duty, a, b)`, `Noise(cells, a, b, seed)` (generated; `size` texels per side, default 1024), `Image(file)` (PNG, sRGB, 8 or 16 bits, grey or colour, its alpha ignored; or EXR, linear, with R, G and B channels or one grey channel Y; relative to the scene file; texels clamped to 0 to 1, NaN to 0); all take `repeat: (u, v)` |
 //! | `materials` | | named `Diffuse(albedo)`, `Phong(albedo, exponent)` (exponent 0 to 1e12), `Ggx(albedo, alpha)` (alpha at least 1e-6: a narrower lobe is below what f64 resolves), each with an optional `texture` that multiplies the albedo |
 //! | `lights` | | `Rect(corner, edge_u, edge_v, radiance)`, `Sphere(center, radius, radiance)`; radiance in W/(m² sr) per channel |
-//! | `shapes` | | `Sphere(center, radius, material, velocity, spin)` (`spin`: rad/s about the centre, axis times rate, at most [`MAX_ANGULAR_VELOCITY`]; a ball rolling at `v` on a floor of normal `up` spins at `up × v / r`), `Quad(corner, edge_u, edge_v, material, velocity)`, `Mesh(obj, material, translate, scale, velocity)` (one material for the whole mesh: the OBJ's `mtllib` and `usemtl` lines are not read, and `usemtl` lines naming several materials are a warning: split such a file, one OBJ and one `Mesh` per material; a mesh without texture coordinates `vt` reads its material's texture at `(0, 0)`) |
+//! | `shapes` | | `Sphere(center, radius, material, velocity, spin)` (`spin`: rad/s about the centre, axis times rate, at most [`MAX_ANGULAR_VELOCITY`]; a ball rolling at `v` on a floor of normal `up` spins at `up × v / r`), `Quad(corner, edge_u, edge_v, material, velocity)`, `Mesh(obj, material, translate, scale, rotate, velocity)` (`rotate`: degrees about the world's `x`, then `y`, then `z` axes through the mesh's origin, after `scale` and before `translate`; one material for the whole mesh: the OBJ's `mtllib` and `usemtl` lines are not read, and `usemtl` lines naming several materials are a warning: split such a file, one OBJ and one `Mesh` per material; a mesh without texture coordinates `vt` reads its material's texture at `(0, 0)`) |
 //! | colours (`albedo`, texture colours, `radiance`) | | each entry 0 to [`MAX_COLOUR`] (1e9) as it is read; a material's `albedo` and a texture's colours at most 1 (a surface reflects no more than it receives) |
 //! | every shape and light | m | within ±[`crate::geometry::MAX_COORD`] (1e12) of the origin, with its motion over the shutter (and at every frame rendered) |
 //! | copies | | at most [`MAX_SHARED_BOX`] (256) shapes, lights and triangles lying exactly on one another (the BVH builder's time grows as the square of their number); at most [`MAX_TRIANGLES`] triangles over all meshes, each placement counted |
@@ -515,6 +515,10 @@ pub enum ShapeDesc {
         /// Uniform scale.
         #[serde(default)]
         scale: Option<Positive>,
+        /// Rotation (degrees) about the mesh's own origin, after scaling and before the
+        /// translation: about `x` first, then `y`, then `z` (the world's axes).
+        #[serde(default)]
+        rotate: Option<V3>,
         /// Velocity (m/s).
         #[serde(default)]
         velocity: Option<V3>,

@@ -660,17 +660,7 @@ fn camera(c: &CameraDesc) -> Result<Camera, Failure> {
         angular_velocity: c.angular_velocity.as_ref().map_or(DVec3::ZERO, |u| v(u.value)),
     };
     if let Some(w) = &c.angular_velocity {
-        let rate = v(w.value).length();
-        if !(rate.is_finite() && rate <= crate::scene::MAX_ANGULAR_VELOCITY) {
-            return Err((
-                w.ordinal,
-                format!(
-                    "angular_velocity must be at most {} rad/s (a thousand turns a second) in length, got {}",
-                    cov_core::num(crate::scene::MAX_ANGULAR_VELOCITY),
-                    cov_core::num(rate)
-                ),
-            ));
-        }
+        rotation_rate(w, "angular_velocity")?;
     }
     let (t0, t1) = camera.shutter.unwrap_or((0.0, 0.0));
     let reach = camera.reach(t0, t1);
@@ -684,6 +674,23 @@ fn camera(c: &CameraDesc) -> Result<Camera, Failure> {
         ));
     }
     Ok(camera)
+}
+
+/// A rotation rate `w` (rad/s, axis times rate) of the field `field`, or `Err` at it when
+/// it is longer than [`crate::scene::MAX_ANGULAR_VELOCITY`].
+fn rotation_rate(w: &At<V3>, field: &str) -> Result<DVec3, Failure> {
+    let rate = v(w.value).length();
+    if rate.is_finite() && rate <= crate::scene::MAX_ANGULAR_VELOCITY {
+        return Ok(v(w.value));
+    }
+    Err((
+        w.ordinal,
+        format!(
+            "{field} must be at most {} rad/s (a thousand turns a second) in length, got {}",
+            cov_core::num(crate::scene::MAX_ANGULAR_VELOCITY),
+            cov_core::num(rate)
+        ),
+    ))
 }
 
 /// A colour of the texture `name` (its description at `at`): a reflectance, at most 1 per
@@ -1194,23 +1201,14 @@ fn shapes(
             ShapeDesc::Sphere {
                 center, radius, spin, ..
             } => {
-                if let Some(w) = spin {
-                    let rate = v(w.value).length();
-                    if !(rate.is_finite() && rate <= crate::scene::MAX_ANGULAR_VELOCITY) {
-                        return Err((
-                            w.ordinal,
-                            format!(
-                                "spin must be at most {} rad/s (a thousand turns a second) in length, got {}",
-                                cov_core::num(crate::scene::MAX_ANGULAR_VELOCITY),
-                                cov_core::num(rate)
-                            ),
-                        ));
-                    }
-                }
+                let spin = match spin {
+                    Some(w) => rotation_rate(w, "spin")?,
+                    None => DVec3::ZERO,
+                };
                 push(Shape::Sphere {
                     center: v(*center),
                     radius: radius.value.0,
-                    spin: spin.as_ref().map_or(DVec3::ZERO, |w| v(w.value)),
+                    spin,
                 })
             }
             ShapeDesc::Quad {
@@ -1231,6 +1229,7 @@ fn shapes(
                 obj,
                 translate,
                 scale,
+                rotate,
                 material,
                 ..
             } => {
@@ -1281,10 +1280,23 @@ fn shapes(
                     ));
                 }
                 let (t, sc) = (translate.map_or(DVec3::ZERO, v), scale.map_or(1.0, |s| s.0));
-                let placed: Vec<ObjTriangle> = tris
-                    .iter()
-                    .map(|&(p, n, uv)| (p.map(|q| q * sc + t), n, uv))
-                    .collect();
+                let placed: Vec<ObjTriangle> = match rotate.map(v).filter(|r| *r != DVec3::ZERO) {
+                    None => tris
+                        .iter()
+                        .map(|&(p, n, uv)| (p.map(|q| q * sc + t), n, uv))
+                        .collect(),
+                    Some(deg) => {
+                        let r = glam::DQuat::from_euler(
+                            glam::EulerRot::ZYX,
+                            deg.z.to_radians(),
+                            deg.y.to_radians(),
+                            deg.x.to_radians(),
+                        );
+                        tris.iter()
+                            .map(|&(p, n, uv)| (p.map(|q| r * (q * sc) + t), n.map(|n| n.map(|m| r * m)), uv))
+                            .collect()
+                    }
+                };
                 // As a sphere's radius or a quad's edge: the mesh's extent, placed, against
                 // the least size where it is.
                 let (lo, hi) = placed

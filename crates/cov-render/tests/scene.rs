@@ -772,6 +772,47 @@ fn a_mesh_placed_twice_is_read_once_and_placed_twice() {
     assert_eq!(three.inputs.len(), 1);
 }
 
+/// `rotate` turns a mesh about `x`, then `y`, then `z`, with its vertex normals: a
+/// triangle in the `xy` plane (normals `+z`) turned 90° about `y` lies in the `yz` plane
+/// facing `x`; turned `(90, 90, 0)` it lies in the `xz` plane facing `−y` (the other order
+/// would leave it facing `x`), and moved by `translate` after the turn.
+#[test]
+fn a_mesh_turns_about_x_then_y_then_z() {
+    let dir = std::env::temp_dir().join(format!("covtrace-rotate-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).expect("temp dir");
+    std::fs::write(
+        dir.join("tri.obj"),
+        "v -1 -1 0\nv 1 -1 0\nv 0 1 0\nvn 0 0 1\nf 1//1 2//1 3//1\n",
+    )
+    .expect("write");
+    let hit = |rotate: &str, from: glam::DVec3, off: glam::DVec3| {
+        let text = BASE.replace(
+            "shapes: [Sphere(center: (0.0, 0.5, 0.0), radius: 0.5, material: \"w\"), SHAPE]",
+            &format!(r#"shapes: [Mesh(obj: "tri.obj", material: "w", rotate: {rotate}, translate: (0.0, 0.0, -20.0))]"#),
+        );
+        let world = World::from_text(&scene_from(&text), "s.ron", &dir).unwrap_or_else(|e| panic!("{e}"));
+        let c = glam::DVec3::new(0.0, 0.0, -20.0);
+        world
+            .geometry
+            .intersect(c + off + from * 5.0, -from, 0.0, 0.0, f64::INFINITY)
+            .map(|h| (h.p - c, h.n))
+    };
+    let (x, y, z, o) = (glam::DVec3::X, glam::DVec3::Y, glam::DVec3::Z, glam::DVec3::ZERO);
+    let (p, n) = hit("(0.0, 90.0, 0.0)", x, o).expect("turned to face x");
+    assert!(p.length() < 1e-9 && (n - x).length() < 1e-9, "{p} {n}");
+    let (p, n) = hit("(90.0, 90.0, 0.0)", -y, o).expect("turned to face -y");
+    assert!(p.length() < 1e-9 && (n + y).length() < 1e-9, "{p} {n}");
+    // A ray along x above the plane y = 0 misses it; it would meet the plane x = 0.
+    assert!(hit("(90.0, 90.0, 0.0)", x, 0.2 * y).is_none(), "not facing x");
+    assert!(
+        hit("(0.0, 90.0, 0.0)", x, 0.2 * y).is_some(),
+        "the plane x = 0 is met off its centre"
+    );
+    let (_, n) = hit("(0.0, 0.0, 0.0)", z, o).expect("unturned");
+    assert!((n - z).length() < 1e-12, "{n}");
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
 /// A mesh placed out of reach is said to be out of reach, as a sphere is, not too small
 /// for where it is.
 #[test]
