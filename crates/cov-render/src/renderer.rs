@@ -524,25 +524,32 @@ impl<'w> Renderer<'w> {
             _ => Vec::new(),
         });
         timing.allocation += secs;
+        // A filter averages reflected light only: the emission of a light seen directly
+        // stays in its pixel (the film's box), so a pixel near one (`sees_light`) takes its
+        // samples as an unfiltered pixel does, whatever filter its reflected light has.
         let plan = |film: &Film, lo: u32| -> (Vec<f64>, Vec<u32>) {
             let rv = relative_variance(film, win.pilot.clone());
             match (method, guide) {
-                (Method::CovUnguarded, Some(g)) => (
-                    rv.iter()
-                        .zip(&g.matched)
-                        .map(|(r, f)| r / filter_area(*f).sqrt())
-                        .collect(),
-                    vec![lo; n],
-                ),
+                (Method::CovUnguarded, Some(g)) => {
+                    let lit = sees_light(film);
+                    (
+                        (0..n)
+                            .map(|i| match lit[i] {
+                                true => rv[i],
+                                false => rv[i] / filter_area(g.matched[i]).sqrt(),
+                            })
+                            .collect(),
+                        vec![lo; n],
+                    )
+                }
                 (Method::Cov, Some(_)) => {
                     let chosen = chosen_filters(&cands, film, s.spp, win.pilot.clone());
                     let keep = (s.spp.floor() as u32).max(lo);
-                    chosen
-                        .iter()
-                        .zip(&rv)
-                        .map(|(f, r)| match f {
-                            Some(f) => (r / filter_area(f.cov()).sqrt(), lo),
-                            None => (*r, keep),
+                    let lit = sees_light(film);
+                    (0..n)
+                        .map(|i| match chosen[i] {
+                            Some(f) if !lit[i] => (rv[i] / filter_area(f.cov()).sqrt(), lo),
+                            _ => (rv[i], keep),
                         })
                         .unzip()
                 }
@@ -855,6 +862,22 @@ pub fn reads_covariance(method: Method, denoise: Denoise, spp: f64, time_limited
     let unread =
         method == Method::Cov && denoise != Denoise::None && variance_pilot(spp).is_none() && !time_limited;
     method.uses_covariance() && !unread
+}
+
+/// Per pixel, whether it or one of its 3×3 neighbours has a sample that saw a light
+/// directly (the neighbourhood over which [`relative_variance`] blurs the pilot's
+/// variance: a light's edge swept by motion reaches pixels whose few pilot samples all
+/// missed it).
+fn sees_light(film: &Film) -> Vec<bool> {
+    let (w, h) = (film.width as usize, film.height as usize);
+    let own: Vec<bool> = film.emitted.iter().map(|e| e.max_element() > 0.0).collect();
+    (0..w * h)
+        .map(|i| {
+            let (x, y) = (i % w, i / w);
+            (y.saturating_sub(1)..(y + 2).min(h))
+                .any(|yy| (x.saturating_sub(1)..(x + 2).min(w)).any(|xx| own[yy * w + xx]))
+        })
+        .collect()
 }
 
 /// The variance method's pilot: a quarter of the budget, at least 2 samples per pixel
