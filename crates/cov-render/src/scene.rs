@@ -17,7 +17,7 @@
 //!
 //! What the format does not have (a user's list, 2026-12-02): quads and meshes that turn
 //! while the shutter is open, motion other than a constant velocity and a sphere's spin, emissive materials, textured lights, point, directional and environment lights, glass and other
-//! dielectrics, per-face OBJ materials, non-uniform or mirrored mesh scale, rotating meshes. The operator
+//! dielectrics, per-face OBJ materials, non-uniform or mirrored mesh scale. The operator
 //! library has what the covariance pass would need for some of them (cov-refraction's
 //! Snell interfaces, cov-motion's rotations); the renderer does not yet use them.
 //!
@@ -41,7 +41,7 @@
 //! | `camera.lens.focal_length` | m | focal length (default 0.05) in [`LENS_RANGE`], < focus distance |
 //! | `camera.shutter.open`, `close` | s | shutter interval, `close − open` in [`SHUTTER_RANGE`] (1e-15 to 1e6) |
 //! | `camera.velocity` | m/s | camera motion during the shutter; the camera stays within ±[`crate::geometry::MAX_COORD`] of the origin over it (and at every frame rendered) |
-//! | `camera.angular_velocity` | rad/s | camera rotation during the shutter about its lens centre: the axis times the rate (`(0.0, 0.5, 0.0)` pans left at 0.5 rad/s, turning the view from −z towards −x), at most [`MAX_ANGULAR_VELOCITY`] (2000π, a thousand turns a second) in length; with `velocity`, `ω = v/d` about the up axis tracks a point at distance `d` |
+//! | `camera.angular_velocity` | rad/s | camera rotation about its lens centre, in the world's axes: the axis times the rate (`(0.0, 0.5, 0.0)` turns the view from −z towards −x at 0.5 rad/s, a pan to the left for a camera looking along −z with +y up), at most [`MAX_ANGULAR_VELOCITY`] (2000π, a thousand turns a second) in length. `look_at` and `up` give the view at time 0, not at the shutter's opening; the camera turns at every instant a ray is traced, a still's (its frame's, `--frame`) too. A camera moving at `v` along its right while turning at `+v/d` about its up axis tracks a point at distance `d` ahead |
 //! | `camera.frame_rate` | 1/s | frames per second of an animation (`--frame K` moves the shutter and a still's instant by `K / frame_rate`), default 24 |
 //! | `textures` | | named `Checker(checks, a, b)`, `Stripes(count, duty, a, b)`, `Noise(cells, a, b, seed)` (generated; `size` texels per side, default 1024), `Image(file)` (PNG, sRGB, 8 or 16 bits, grey or colour, its alpha ignored; or EXR, linear, with R, G and B channels or one grey channel Y; relative to the scene file; texels clamped to 0 to 1, NaN to 0); all take `repeat: (u, v)` |
 //! | `materials` | | named `Diffuse(albedo)`, `Phong(albedo, exponent)` (exponent 0 to 1e12), `Ggx(albedo, alpha)` (alpha at least 1e-6: a narrower lobe is below what f64 resolves), each with an optional `texture` that multiplies the albedo |

@@ -683,12 +683,17 @@ fn rotation_rate(w: &At<V3>, field: &str) -> Result<DVec3, Failure> {
     if rate.is_finite() && rate <= crate::scene::MAX_ANGULAR_VELOCITY {
         return Ok(v(w.value));
     }
+    // A vector whose length overflows is shown by its largest entry.
+    let got = if rate.is_finite() {
+        cov_core::num(rate)
+    } else {
+        format!("more than {}", cov_core::num(v(w.value).abs().max_element()))
+    };
     Err((
         w.ordinal,
         format!(
-            "{field} must be at most {} rad/s (a thousand turns a second) in length, got {}",
+            "{field} must be at most {} rad/s (a thousand turns a second) in length, got {got}",
             cov_core::num(crate::scene::MAX_ANGULAR_VELOCITY),
-            cov_core::num(rate)
         ),
     ))
 }

@@ -501,6 +501,8 @@ fn a_camera_turning_too_fast_is_refused_at_its_rate() {
         e.contains("angular_velocity must be at most 6283.185307179586 rad/s (a thousand turns a second) in length, got 100000"),
         "{e}"
     );
+    let e = error(&scene(&[("LENS", ", angular_velocity: (1e300, 1e300, 0.0)")]));
+    assert!(e.contains("in length, got more than 1e300"), "{e}");
     let ok = World::from_text(
         &scene(&[(
             "LENS",
