@@ -255,25 +255,11 @@ fn a_spinning_sphere_carries_its_surface() {
     )
     .unwrap_or_else(|e| panic!("{e}"));
     let quarter = std::f64::consts::FRAC_PI_2 / w;
-    let from_z = world
-        .geometry
-        .intersect(
-            glam::DVec3::new(0.0, 0.0, 3.0),
-            -glam::DVec3::Z,
-            0.0,
-            0.0,
-            f64::INFINITY,
-        )
-        .expect("front at 0");
-    let from_x = world
-        .geometry
-        .intersect(
-            glam::DVec3::new(3.0, 0.0, 0.0),
-            -glam::DVec3::X,
-            quarter,
-            0.0,
-            f64::INFINITY,
-        )
+    // What a ray from `o` along `d` at time `t` meets.
+    let meet =
+        |w: &World, o: glam::DVec3, d: glam::DVec3, t: f64| w.geometry.intersect(o, d, t, 0.0, f64::INFINITY);
+    let from_z = meet(&world, glam::DVec3::new(0.0, 0.0, 3.0), -glam::DVec3::Z, 0.0).expect("front at 0");
+    let from_x = meet(&world, glam::DVec3::new(3.0, 0.0, 0.0), -glam::DVec3::X, quarter)
         .expect("side a quarter turn later");
     assert!(
         (from_z.uv - from_x.uv).length() < 1e-12,
@@ -295,16 +281,7 @@ fn a_spinning_sphere_carries_its_surface() {
         Path::new("."),
     )
     .unwrap();
-    let side = still
-        .geometry
-        .intersect(
-            glam::DVec3::new(3.0, 0.0, 0.0),
-            -glam::DVec3::X,
-            quarter,
-            0.0,
-            f64::INFINITY,
-        )
-        .unwrap();
+    let side = meet(&still, glam::DVec3::new(3.0, 0.0, 0.0), -glam::DVec3::X, quarter).unwrap();
     assert!((side.uv - from_z.uv).length() > 0.2, "{:?}", side.uv);
     // Rolling along +x at 1 m/s on a floor facing +y: spin (0, 0, −v/r).
     let rolling = World::from_text(
@@ -313,13 +290,7 @@ fn a_spinning_sphere_carries_its_surface() {
         Path::new("."),
     )
     .unwrap();
-    let at = |o: glam::DVec3, d: glam::DVec3| {
-        rolling
-            .geometry
-            .intersect(o, d, 0.0, 0.0, f64::INFINITY)
-            .expect("the ball")
-            .velocity
-    };
+    let at = |o: glam::DVec3, d: glam::DVec3| meet(&rolling, o, d, 0.0).expect("the ball").velocity;
     let bottom = at(glam::DVec3::new(0.0, -3.0, 0.0), glam::DVec3::Y);
     let top = at(glam::DVec3::new(0.0, 3.0, 0.0), -glam::DVec3::Y);
     assert!(bottom.length() < 1e-12, "the contact point moves at {bottom}");
