@@ -383,6 +383,19 @@ pub(crate) fn relative_variance(film: &Film, rows: Range<u32>) -> Vec<f64> {
         .collect()
 }
 
+/// Per pixel, whether it or one of its 3×3 neighbours has a sample that saw a light
+/// directly: the neighbourhood over which [`relative_variance`] blurs the pilot's
+/// variance (a light's edge swept by motion reaches pixels whose few pilot samples all
+/// missed it).
+pub(crate) fn sees_light(film: &Film) -> Vec<bool> {
+    use rayon::prelude::*;
+    let (w, h) = (film.width as i64, film.height as i64);
+    (0..w * h)
+        .into_par_iter()
+        .map(|i| around(w, h, i, 1).any(|(j, _)| film.emitted[j].max_element() > 0.0))
+        .collect()
+}
+
 /// The image's own content: the sensor's image-space Σ `[xx, xy, yy]` less the pixel
 /// filter's window (`1/(4π² f²)` per axis for a filter of std `f` px, which the sensor adds
 /// because it describes the integrand a pixel's samples see), clamped to PSD. Reconstruction

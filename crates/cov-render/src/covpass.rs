@@ -1,7 +1,7 @@
 //! The covariance pass: for each pixel, a few covariance paths that follow the path
 //! tracer's paths (camera → x₁ → light, camera → x₁ → x₂ → light, …; up to the scene's
-//! `max_depth` surface vertices), each vertex's direct light turned into an operator chain of the
-//! library (light source, travel, blocker edge, reflection at each vertex back to the
+//! `max_depth` surface vertices), each vertex's direct light turned into an operator
+//! chain of the library (light source, travel, blocker edge, reflection at each vertex back to the
 //! camera, motion, lens, shutter), evaluated, and reduced to the sensor's per-pixel
 //! decisions (cov-sensor). Every vertex's chain is weighted by the radiance it carries to
 //! the camera, ignoring visibility, so a shadowed region keeps the frequency content of
@@ -20,8 +20,8 @@
 //!    outgoing ray; then the change of handedness and the texture), inside `Moving` when
 //!    the shape moves;
 //! 4. for a later vertex (`depth` 2 or more; the renderer's default is [`DEFAULT_DEPTH`],
-//!    one), travel back along the path to the vertex before, with a `BlockerEdge` where probes from the
-//!    first vertex at its lobe's angular width see an outline beside the segment, and the
+//!    one), travel back along the path to the vertex before, with a `BlockerEdge` where
+//!    probes from the first vertex at its lobe's angular width see an outline beside the segment, and the
 //!    reflection there, as in 3 (glossy inter-reflection: a glossy floor mirroring what
 //!    stands on it, the outline blurred by the floor's lobe);
 //! 5. travel to the camera, with a `Moving` `BlockerEdge` where auxiliary camera rays
@@ -1001,6 +1001,25 @@ pub fn covariance_maps(
     covariance_rows(world, paths, stride, DEFAULT_DEPTH, seed, rows, progress)
 }
 
+/// `Err` (the setting `name`) unless `depth` is 1 to the scene's [`World::max_depth`]: a
+/// covariance path follows the path tracer's vertices, and no more.
+///
+/// # Errors
+/// `depth` out of that range.
+pub fn check_depth(world: &World, depth: u32, name: &'static str) -> Result<(), crate::RenderError> {
+    let most = world.max_depth.min(MAX_DEPTH);
+    if (1..=most).contains(&depth) {
+        return Ok(());
+    }
+    Err(crate::RenderError::setting(
+        name,
+        format!(
+            "1 to the scene's max_depth, {most} (2 where the scene file gives none; a covariance path follows the path tracer's vertices)"
+        ),
+        depth,
+    ))
+}
+
 /// [`covariance_maps`] of the tiles whose first row lies in `rows` (a part of a render,
 /// the `parts` module); the other pixels keep [`PixelCov::default`]. Each tile draws from
 /// its own generator, seeded by its index in the whole image, so a tile's values are the
@@ -1033,16 +1052,7 @@ pub fn covariance_rows(
             paths,
         ));
     }
-    if !(1..=world.max_depth.min(MAX_DEPTH)).contains(&depth) {
-        return Err(crate::RenderError::setting(
-            "the covariance paths' depth",
-            format!(
-                "1 to the scene's max_depth, {} (2 where the scene file gives none; the path tracer's vertices)",
-                world.max_depth.min(MAX_DEPTH)
-            ),
-            depth,
-        ));
-    }
+    check_depth(world, depth, "the covariance paths' depth")?;
     let cc = CovCamera::new(world).map_err(|e| crate::RenderError::Camera(e.to_string()))?;
     let (w, h) = (world.camera.width, world.camera.height);
     let tl: Vec<(usize, (u32, u32, u32, u32))> = crate::film::tiles(w, h)

@@ -40,7 +40,7 @@ use std::time::Instant;
 use glam::DVec3;
 
 use crate::RenderError;
-use crate::adaptive::{Guide, MAX_RATIO, allocate_floors, filter_area, relative_variance};
+use crate::adaptive::{Guide, MAX_RATIO, allocate_floors, filter_area, relative_variance, sees_light};
 use crate::covpass::{CovMaps, DEFAULT_DEPTH, MAX_COV_PATHS, MAX_DEPTH, STRIDES, covariance_rows};
 use crate::denoise::Denoise;
 use crate::film::{Film, Filter, Gaussian, Image, MAX_SPP, Progress};
@@ -302,16 +302,7 @@ impl<'w> Renderer<'w> {
     /// has tile rows ([`part_rows`]).
     pub fn new(world: &'w World, settings: RenderSettings) -> Result<Renderer<'w>, RenderError> {
         settings.check()?;
-        if settings.cov_depth > world.max_depth {
-            return Err(RenderError::setting(
-                "cov_depth",
-                format!(
-                    "1 to the scene's max_depth, {} (2 where the scene file gives none; a covariance path follows the path tracer's vertices)",
-                    world.max_depth
-                ),
-                settings.cov_depth,
-            ));
-        }
+        crate::covpass::check_depth(world, settings.cov_depth, "cov_depth")?;
         part_rows(world.camera.height, 1, settings.parts)?;
         let (w, h) = (world.camera.width, world.camera.height);
         check_memory(w, h, settings.method, available_memory())?;
@@ -525,7 +516,7 @@ impl<'w> Renderer<'w> {
         });
         timing.allocation += secs;
         // A filter averages reflected light only: the emission of a light seen directly
-        // stays in its pixel (the film's box), so a pixel near one (`sees_light`) takes its
+        // stays in its pixel (the film's box), so a pixel near one ([`sees_light`]) takes its
         // samples as an unfiltered pixel does, whatever filter its reflected light has.
         let plan = |film: &Film, lo: u32| -> (Vec<f64>, Vec<u32>) {
             let rv = relative_variance(film, win.pilot.clone());
@@ -862,22 +853,6 @@ pub fn reads_covariance(method: Method, denoise: Denoise, spp: f64, time_limited
     let unread =
         method == Method::Cov && denoise != Denoise::None && variance_pilot(spp).is_none() && !time_limited;
     method.uses_covariance() && !unread
-}
-
-/// Per pixel, whether it or one of its 3×3 neighbours has a sample that saw a light
-/// directly (the neighbourhood over which [`relative_variance`] blurs the pilot's
-/// variance: a light's edge swept by motion reaches pixels whose few pilot samples all
-/// missed it).
-fn sees_light(film: &Film) -> Vec<bool> {
-    let (w, h) = (film.width as usize, film.height as usize);
-    let own: Vec<bool> = film.emitted.iter().map(|e| e.max_element() > 0.0).collect();
-    (0..w * h)
-        .map(|i| {
-            let (x, y) = (i % w, i / w);
-            (y.saturating_sub(1)..(y + 2).min(h))
-                .any(|yy| (x.saturating_sub(1)..(x + 2).min(w)).any(|xx| own[yy * w + xx]))
-        })
-        .collect()
 }
 
 /// The variance method's pilot: a quarter of the budget, at least 2 samples per pixel

@@ -16,8 +16,9 @@
 //! ```
 //!
 //! What the format does not have (a user's list, 2026-12-02): quads and meshes that turn
-//! while the shutter is open, motion other than a constant velocity and a sphere's spin, emissive materials, textured lights, point, directional and environment lights, glass and other
-//! dielectrics, per-face OBJ materials, non-uniform or mirrored mesh scale. The operator
+//! while the shutter is open, motion other than a constant velocity and a sphere's spin,
+//! emissive materials, textured lights, point, directional and environment lights, glass
+//! and other dielectrics, per-face OBJ materials, non-uniform or mirrored mesh scale. The operator
 //! library has what the covariance pass would need for some of them (cov-refraction's
 //! Snell interfaces, cov-motion's rotations); the renderer does not yet use them.
 //!

@@ -190,17 +190,16 @@ fn reflected<S: Sampler + ?Sized>(
         } else {
             None
         };
-        let Some(b) = next else {
-            l += beta * here;
-            break;
-        };
-        if last || b.hit.light.is_some() {
-            // A light found by BRDF sampling: the other half of the MIS pair.
+        // A light found by BRDF sampling: the other half of the MIS pair.
+        if let Some(b) = &next
+            && (last || b.hit.light.is_some())
+        {
             here += b.emission(world, &v);
-            l += beta * here;
-            break;
         }
         l += beta * here;
+        let Some(b) = next.filter(|b| !last && b.hit.light.is_none()) else {
+            break;
+        };
         beta *= b.throughput;
         if k + 1 >= ROULETTE_FROM {
             let q = beta.max_element().min(1.0);
