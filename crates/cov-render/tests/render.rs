@@ -25,6 +25,20 @@ fn own_window() -> f64 {
     1.0 / (4.0 * std::f64::consts::PI.powi(2) * f * f)
 }
 
+/// A pixel of a covariance map: finite, its Σ PSD, its predicted samples non-negative.
+fn finite_and_psd(p: &cov_render::covpass::PixelCov, what: &str) {
+    let [a, b, c] = p.sigma;
+    assert!(
+        a.is_finite() && b.is_finite() && c.is_finite() && p.spp.is_finite(),
+        "{what}: {p:?}"
+    );
+    assert!(
+        a >= 0.0 && c >= 0.0 && a * c - b * b >= -1e-9 * (a * c).max(1e-300),
+        "{what}: not PSD {p:?}"
+    );
+    assert!(p.spp >= 0.0, "{what}: {p:?}");
+}
+
 fn pool(threads: usize) -> rayon::ThreadPool {
     rayon::ThreadPoolBuilder::new()
         .num_threads(threads)
@@ -144,15 +158,7 @@ fn covariance_paths_follow_a_deeper_scene_and_no_further() {
     let one = cov_render::covpass::covariance_rows(&world, 2, 4, 1, 3, 0..24, None).expect("depth 1");
     let four = cov_render::covpass::covariance_rows(&world, 2, 4, 4, 3, 0..24, None).expect("depth 4");
     for p in &four.pixels {
-        let [a, b, c] = p.sigma;
-        assert!(
-            a.is_finite() && b.is_finite() && c.is_finite() && p.spp.is_finite(),
-            "{p:?}"
-        );
-        assert!(
-            a >= 0.0 && c >= 0.0 && b * b <= a * c * (1.0 + 1e-9) + 1e-300,
-            "{p:?}"
-        );
+        finite_and_psd(p, "depth 4");
     }
     assert_ne!(one, four, "the later vertices change the maps");
     let e = cov_render::covpass::covariance_rows(&world, 2, 4, 5, 3, 0..24, None)
@@ -398,16 +404,7 @@ fn covariance_maps_are_finite_psd_and_see_the_scene() {
         let maps = covariance_maps(&world, 4, 1, 1, None).unwrap();
         assert_eq!(maps.pixels.len(), 32 * 24);
         for p in &maps.pixels {
-            let [a, b, c] = p.sigma;
-            assert!(
-                a.is_finite() && b.is_finite() && c.is_finite() && p.spp.is_finite(),
-                "{name}: {p:?}"
-            );
-            assert!(
-                a >= 0.0 && c >= 0.0 && a * c - b * b >= -1e-9 * (a * c).max(1e-300),
-                "{name}: not PSD {p:?}"
-            );
-            assert!(p.spp >= 0.0);
+            finite_and_psd(p, name);
         }
         // The prediction varies over the image: some pixels need more samples than others.
         let (lo, hi) = maps
