@@ -182,14 +182,39 @@ pub(crate) fn field_position(text: &str, line: usize, col: usize, name: &str) ->
 /// col)` (1-based, as ron reports it) being in that value or just before it, where ron
 /// reports a value of the wrong type, or at the closing parenthesis of a tuple it
 /// refused: the nearest `name:` before the value at its own bracket level, the name's
-/// position, and the value as written (at most 40 characters). `None` when no `name:`
-/// stands between the position and the bracket that opens its level (an entry of a
-/// list). A leading byte-order mark is not counted, as ron does not count it.
+/// position, and the value as written (at most 40 characters). An optional value written
+/// `Some(…)` is the field's value whole: a position inside it is the field's. `None`
+/// when no `name:` stands between the position and the bracket that opens its level (an
+/// entry of a list). A leading byte-order mark is not counted, as ron does not count it.
 pub fn field_at(text: &str, line: usize, col: usize) -> Option<(String, (usize, usize), String)> {
     let text = text.strip_prefix('\u{feff}').unwrap_or(text);
     let written: Vec<char> = text.chars().collect();
     let chars = code_of(&written);
     let pos = char_positions(&chars);
+    let (start, end, colon) = field_span(&chars, &pos, line, col)?;
+    let name: String = chars[start..end].iter().collect();
+    Some((name, pos[start], value_from(&written, &chars, colon + 1)))
+}
+
+/// Where the value of [`field_at`]'s field starts (line, column, 1-based): its first
+/// character after the colon that is not blank or a comment.
+pub fn value_position(text: &str, line: usize, col: usize) -> Option<(usize, usize)> {
+    let text = text.strip_prefix('\u{feff}').unwrap_or(text);
+    let chars = code_of(&text.chars().collect::<Vec<char>>());
+    let pos = char_positions(&chars);
+    let (_, _, colon) = field_span(&chars, &pos, line, col)?;
+    let v = (colon + 1..chars.len()).find(|&v| !chars[v].is_whitespace())?;
+    Some(pos[v])
+}
+
+/// [`field_at`]'s field in `chars` (a [`code_of`], `pos` its positions): the indices of
+/// the start and the end of its name and of its colon.
+fn field_span(
+    chars: &[char],
+    pos: &[(usize, usize)],
+    line: usize,
+    col: usize,
+) -> Option<(usize, usize, usize)> {
     let mut at = pos.iter().position(|&p| p >= (line, col)).unwrap_or(chars.len());
     // A tuple refused at its closing parenthesis: its field precedes the opening one.
     if chars.get(at) == Some(&')') {
@@ -213,6 +238,8 @@ pub fn field_at(text: &str, line: usize, col: usize) -> Option<(String, (usize, 
         i -= 1;
         match chars[i] {
             ')' | ']' | '}' => depth += 1,
+            // `Some(` opens no level of its own: the field is the one it is the value of.
+            '(' if depth == 0 && word_before(chars, i) == "Some" => {}
             '(' | '[' | '{' if depth == 0 => return None,
             '(' | '[' | '{' => depth -= 1,
             ':' if depth == 0 => break i,
@@ -230,10 +257,21 @@ pub fn field_at(text: &str, line: usize, col: usize) -> Option<(String, (usize, 
     if start == end || !(chars[start].is_alphabetic() || chars[start] == '_') {
         return None;
     }
-    let name: String = chars[start..end].iter().collect();
-    // The value: from the first character after the colon to the comma or bracket that
-    // ends it at its own level.
-    Some((name, pos[start], value_from(&written, &chars, colon + 1)))
+    Some((start, end, colon))
+}
+
+/// The word (letters, digits, `_`) that ends right before index `i` of `chars`, blanks
+/// between them skipped.
+fn word_before(chars: &[char], i: usize) -> String {
+    let mut end = i;
+    while end > 0 && chars[end - 1].is_whitespace() {
+        end -= 1;
+    }
+    let mut start = end;
+    while start > 0 && (chars[start - 1].is_alphanumeric() || chars[start - 1] == '_') {
+        start -= 1;
+    }
+    chars[start..end].iter().collect()
 }
 
 /// The value written from `v` in `written` (`chars`: its [`code_of`], comments blanked

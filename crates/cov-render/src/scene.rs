@@ -699,17 +699,33 @@ impl SceneFile {
                 };
             }
             let mut message = e.code.to_string();
+            // Where the message points: ron's position, or the start of the value it is
+            // about (ron stops after a sign, inside a number or before a string's blank).
+            let mut at = (line, col);
             let field = || cov_path::field_at(text, line, col);
+            let value_at = || cov_path::value_position(text, line, col).unwrap_or((line, col));
             // `0x1` where a decimal belongs: ron reads the `0` (so a checked type refuses 0,
             // or ron stops at the `x`).
             if let Some((name, _, value)) = field()
                 && let Some(words) = cov_path::not_decimal(&value)
             {
                 message = format!("`{name}` = {}: {words}", cov_core::echo(&value));
+                at = value_at();
             } else if cov_path::decimal_for_whole(&message, text, line, col)
                 && let Some(words) = whole_words(text, line, col)
             {
                 message = words;
+                at = (line, cov_path::number_start(text, line, col));
+            } else if let Some(tail) = message.strip_prefix("Unexpected duplicate field named `")
+                && let Some((name, rest)) = tail.split_once('`')
+            {
+                // ron's `in `Camera``: the type's name, which the scene writes in lower case
+                // only as a field (`camera: (…)`); said as the type.
+                let owner = rest
+                    .strip_prefix(" in ")
+                    .map(|o| format!(" in {o}"))
+                    .unwrap_or_default();
+                message = format!("`{name}` is given twice{owner}: remove one");
             } else if let ron::Error::Message(m) = &e.code
                 && let Some((name, ..)) = field()
             {
@@ -718,6 +734,7 @@ impl SceneFile {
                 } else {
                     format!("`{name}`: {m}")
                 };
+                at = value_at();
             } else if let Some((name, _, value)) = field()
                 && let Some(what) = cov_path::expected_value(&message, &value)
             {
@@ -728,6 +745,7 @@ impl SceneFile {
                 } else {
                     format!("`{name}` = {value}: expected {what}")
                 };
+                at = value_at();
             } else if let Some(words) = tuple_words(text, line, col, &message) {
                 message = words;
             } else if message.starts_with("Expected") && !message.contains(" found ") {
@@ -736,7 +754,7 @@ impl SceneFile {
             }
             SceneError {
                 file: file.to_string(),
-                at: Some((line, col)),
+                at: Some(at),
                 message: cov_core::one_line(&message),
             }
         })

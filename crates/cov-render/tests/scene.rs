@@ -473,6 +473,29 @@ fn small_inputs_cannot_ask_for_unbounded_work() {
     );
 }
 
+/// An error about a value points at the value's first character, whatever ron's own
+/// position: after a sign, inside a number, or at the blank before a string.
+#[test]
+fn a_wrong_value_is_pointed_at_where_it_starts() {
+    // `camera: (position: (0.0, 1.0, 3.0), look_at: LOOK, fov: FOV, …`: FOV's value is
+    // written from column 72 of line 2.
+    for (fov, want) in [
+        ("\"wide\"", "2:72: `fov` = \"wide\": expected a number"),
+        ("-40.0", "2:72: `fov` must be finite and > 0, got -40"),
+        ("0x28", "2:72: `fov` = 0x28: a hexadecimal number"),
+        ("   true", "2:75: `fov` = true: expected a number"),
+    ] {
+        let e = error(&scene(&[("FOV", fov)]));
+        assert!(e.starts_with(want), "fov {fov}: {e}");
+    }
+    // A field written twice: said in the scene's words, at the second one.
+    let e = error(&scene(&[("FOV", "40.0, fov: 30.0")]));
+    assert!(
+        e.starts_with("2:78: `fov` is given twice in `Camera`: remove one"),
+        "{e}"
+    );
+}
+
 /// A path's depth is a count the user controls: 1 to 32, refused where it is written,
 /// 2 when left out.
 #[test]
@@ -481,8 +504,13 @@ fn a_path_depth_is_bounded_where_it_is_written() {
     for (d, want) in [
         ("0", "2:16: `max_depth` must be 1 to 32 surface vertices, got 0"),
         ("33", "2:16: `max_depth` must be 1 to 32 surface vertices, got 33"),
-        ("-1", "2:17: `max_depth` = -1 is out of range for a whole number"),
-        ("2.5", "2:17: `max_depth` = 2.5: expected a whole number"),
+        ("-1", "2:16: `max_depth` = -1 is out of range for a whole number"),
+        ("2.5", "2:16: `max_depth` = 2.5: expected a whole number"),
+        (
+            "Some(0)",
+            "2:16: `max_depth` must be 1 to 32 surface vertices, got 0",
+        ),
+        ("\"two\"", "2:16: `max_depth` = \"two\": expected a whole number"),
     ] {
         let e = error(&scene_from(&at(d)));
         assert!(e.starts_with(want), "max_depth {d}: {e}");
