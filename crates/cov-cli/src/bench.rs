@@ -239,14 +239,16 @@ fn folder(dir: &Path, what: &str) -> Result<(), String> {
 /// The cached reference's file, and its image when the cache holds a sound one.
 fn cached(a: &BenchArgs, world: &World, cache: &Path) -> (PathBuf, Option<cov_render::Image>) {
     let (w, h) = (world.camera.width, world.camera.height);
-    // The version names the path tracer's estimator: v2 combines light and BRDF sampling
-    // at a glossy second vertex, whose references lack v1's fireflies; v3 maps textures on
-    // spheres unmirrored; v4 keys the scene by its fingerprint, so that a texture or a
-    // mesh changed under the same scene text is a new reference.
+    // Keyed by the estimator's revision (`ESTIMATOR_REVISION`), so that a reference an
+    // older tracer rendered is never measured against, and by the scene's fingerprint, so
+    // that a texture or a mesh changed under the same scene text is a new reference.
     let key = fnv(
         format!(
-            "covtrace-reference-v4 {w}x{h} {} {} {:016x}",
-            a.ref_spp, a.seed, world.fingerprint
+            "covtrace-reference-v{} {w}x{h} {} {} {:016x}",
+            cov_render::trace::ESTIMATOR_REVISION,
+            a.ref_spp,
+            a.seed,
+            world.fingerprint
         )
         .as_bytes(),
         0xcbf2_9ce4_8422_2325,
