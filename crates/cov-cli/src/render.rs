@@ -526,12 +526,13 @@ fn render_one(
         write_maps(maps, sp.filter, sp.max_filter, &density, &filter, &json).map_err(|e| e.to_string())?;
         let mean_spp = maps.pixels.iter().map(|p| p.spp).sum::<f64>() / maps.pixels.len().max(1) as f64;
         out.push_str(&format!(
-            "covariance: {} path(s) per {s}×{s} block, layout {} ({}), in {:.2} s ({:.1}% of the render); predicted {mean_spp:.1} spp on average\n",
+            "covariance: {} path(s) per {s}×{s} block, layout {} ({}), in {:.2} s ({:.1}% of the render); predicted {mean_spp:.1} spp on average (density map: log scale, 1 to {:.0} spp)\n",
             maps.paths_per_block,
             maps.layout,
             layout_axes(maps.layout),
             r.timing.covariance,
             100.0 * r.timing.covariance / total.max(1e-9),
+            cov_render::output::density_scale_top(maps),
             s = maps.stride,
         ));
     } else if r.method.uses_covariance() {

@@ -152,7 +152,31 @@ pub fn colormap(t: f64) -> [u8; 3] {
     [c(0), c(1), c(2)]
 }
 
-/// Writes the density map (samples per pixel, log scale from 1 to the largest) and the
+/// The share of a density map's pixels below the top of its colour scale
+/// ([`write_maps`]): a few blocks of huge predicted density (a tiny bright light, a
+/// caustic: 37,440 spp where the median was 7.7) would otherwise squeeze the rest of the
+/// map into its darkest colours.
+pub const DENSITY_SCALE_QUANTILE: f64 = 0.99;
+
+/// The top of the density map's colour scale: the [`DENSITY_SCALE_QUANTILE`] of the
+/// maps' samples per pixel, at least 2 (the scale is logarithmic from 1).
+pub fn density_scale_top(maps: &CovMaps) -> f64 {
+    let mut spp: Vec<f64> = maps
+        .pixels
+        .iter()
+        .map(|p| p.spp)
+        .filter(|s| s.is_finite())
+        .collect();
+    if spp.is_empty() {
+        return 2.0;
+    }
+    spp.sort_by(f64::total_cmp);
+    let k = ((spp.len() - 1) as f64 * DENSITY_SCALE_QUANTILE).round() as usize;
+    spp[k.min(spp.len() - 1)].max(2.0)
+}
+
+/// Writes the density map (samples per pixel, log scale from 1 to
+/// [`density_scale_top`]; denser pixels take the top colour) and the
 /// filter map (reconstruction filter std of the content, [`content`], 0 to `max_filter`
 /// px) as PNGs, and the maps as JSON.
 ///
@@ -166,17 +190,11 @@ pub fn write_maps(
     filter: &Path,
     json: &Path,
 ) -> Result<(), RenderError> {
-    let hi = maps
-        .pixels
-        .iter()
-        .map(|p| p.spp)
-        .fold(1.0f64, f64::max)
-        .ln()
-        .max(1e-9);
+    let hi = density_scale_top(maps).ln();
     let w = maps.width;
     let img = image::RgbImage::from_fn(maps.width, maps.height, |x, y| {
         let p = &maps.pixels[(y * w + x) as usize];
-        image::Rgb(colormap(p.spp.max(1.0).ln() / hi))
+        image::Rgb(colormap((p.spp.max(1.0).ln() / hi).min(1.0)))
     });
     save(img, density)?;
     let stds: Vec<f64> = maps
