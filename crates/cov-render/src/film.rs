@@ -809,8 +809,12 @@ impl Film {
     /// the ratio `Σ split / Σ s²/n` over the pixels within [`SPLIT_REACH`] that have a
     /// split, at most 1 (a scrambled net is not taken to be worse than Monte Carlo).
     pub fn variance_of_mean(&self) -> Vec<f64> {
+        self.variance_of_mean_from(&self.variance())
+    }
+
+    /// [`Film::variance_of_mean`] given the film's [`Film::variance`] `var`.
+    pub(crate) fn variance_of_mean_from(&self, var: &[f64]) -> Vec<f64> {
         const R: usize = SPLIT_REACH;
-        let var = self.variance();
         let mc: Vec<f64> = (0..self.count.len())
             .into_par_iter()
             .map(|i| var[i] / f64::from(self.count[i].max(1)))

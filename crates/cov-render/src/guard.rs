@@ -125,10 +125,12 @@ pub fn candidate(guide: &Guide, scale: f64, rows: Range<u32>) -> Vec<Gaussian> {
 
 /// Reconstructs `film`'s reflected light with the guard (module docs).
 ///
-/// `candidates` are [`candidates`] of the film's guide; with more than [`PILOT_SCALES`]
-/// of them, the last only stands in for the box. Only the pixels of `rows` are
+/// `candidates` are [`candidates`] of the film's guide (the first [`SCALES`]`.len()` of
+/// them are read); with more than [`PILOT_SCALES`] of them, the last only stands in for
+/// the box. Only the pixels of `rows` are
 /// estimated and chosen (a part of a render, the `parts` module); the others take the box.
 pub fn guarded(candidates: &[Vec<Gaussian>], film: &Film, rows: Range<u32>) -> Guarded {
+    let candidates = &candidates[..candidates.len().min(SCALES.len())];
     let sums: Vec<Vec<(DVec3, f64)>> = candidates.iter().map(|f| film.splat_each(f)).collect();
     let lum: Vec<Vec<[f64; 2]>> = sums
         .iter()
@@ -201,107 +203,107 @@ fn choose(
     let (w, h) = (film.width as i64, film.height as i64);
     let inside = |p: usize| rows.contains(&((p as i64 / w.max(1)) as u32));
     let n = film.count.len();
-    let lx: Vec<f64> = (0..n)
-        .into_par_iter()
-        .map(|i| match film.count[i] {
-            0 => 0.0,
-            c => luminance(film.reflected[i] / f64::from(c)),
-        })
-        .collect();
-    let var = one_sample_variance(film);
-    // The variance of the pixel's mean in the box's error: Monte Carlo's, `s²/n` (an
-    // upper bound for a scrambled net's mean).
-    let s2: Vec<f64> = (0..n)
-        .into_par_iter()
-        .map(|i| var[i] / f64::from(film.count[i].max(1)))
-        .collect();
-    // A variance of the pixel's mean at the target count: `n/target` of the film's.
-    let at_target = |v: &[f64]| -> Vec<f64> {
-        (0..n)
-            .into_par_iter()
-            .map(|i| {
-                let c = f64::from(film.count[i].max(1));
-                v[i] * (c / target.max(c))
-            })
-            .collect()
-    };
-    let s2_target = at_target(&s2);
+    let own = film.variance();
+    let var = one_sample_variance(film, &own);
     // The noise that the cross-validation residual carries, taken off it to leave the
     // filter's bias: the estimate that sees the net's convergence, so that Monte
     // Carlo's overstated noise does not hide a bias (module docs).
-    let of_mean = film.variance_of_mean();
-    let noise: Vec<f64> = (0..n)
+    let of_mean = film.variance_of_mean_from(&own);
+    // Per pixel, in one pass: [PX_MEAN] the mean luminance; [PX_NOISE] the noise taken
+    // off the residual (Monte Carlo's `s²/n` where one sample gives no split);
+    // [PX_MC_AT] the variance of the pixel's mean in the box's error, Monte Carlo's
+    // `s²/n` (an upper bound for a scrambled net's mean), and [PX_NOISE_AT] the noise, at
+    // the target count: `n/target` of the film's (the second in a filter's own share of
+    // its estimate, `α² σ²`, read as the noise is: module docs).
+    let px: Vec<[f64; 4]> = (0..n)
         .into_par_iter()
-        .map(|i| if film.count[i] >= 2 { of_mean[i] } else { s2[i] })
+        .map(|i| {
+            let count = film.count[i];
+            let mean = match count {
+                0 => 0.0,
+                c => luminance(film.reflected[i] / f64::from(c)),
+            };
+            let c = f64::from(count.max(1));
+            let s2 = var[i] / c;
+            let noise = if count >= 2 { of_mean[i] } else { s2 };
+            let at_target = c / target.max(c);
+            [mean, noise, s2 * at_target, noise * at_target]
+        })
         .collect();
-    // The same variance at the target count, in a filter's own share of its estimate
-    // (`α² σ²`): the noise taken off its residual, read the same way (module docs).
-    let own_target = at_target(&noise);
     // The normaliser of the relative error: the squared 3×3 mean luminance.
-    let norm: Vec<f64> = box3(w, h, &lx, rows)
+    let norm: Vec<f64> = box3(w, h, rows, |j| [px[j][PX_MEAN]])
         .par_iter()
-        .map(|m| m * m + REL_EPS)
+        .map(|[m]| m * m + REL_EPS)
         .collect();
-    let mut risks: Vec<Vec<f64>> = Vec::with_capacity(candidates.len() + 1);
-    for (k, (filters, acc)) in candidates.iter().zip(lum).enumerate() {
-        // The stand-in for the box is judged on the box's terms.
-        let own_target = if stand_in && k + 1 == candidates.len() {
-            &s2_target
-        } else {
-            &own_target
-        };
-        let risk: Vec<f64> = (0..n)
-            .into_par_iter()
-            .map(|p| {
-                let c = f64::from(film.count[p]);
+    // Each candidate's estimated relative error per pixel, the box's last (at
+    // `candidates.len()`), before the 3×3 mean.
+    let boxed = candidates.len();
+    let raw: Vec<[f64; MAX_CHOICES]> = (0..n)
+        .into_par_iter()
+        .map(|p| {
+            let mut r = [0.0; MAX_CHOICES];
+            let c = f64::from(film.count[p]);
+            for (k, (filters, acc)) in candidates.iter().zip(lum).enumerate() {
+                // The stand-in for the box is judged on the box's terms.
+                let own_target = if stand_in && k + 1 == boxed {
+                    px[p][PX_MC_AT]
+                } else {
+                    px[p][PX_NOISE_AT]
+                };
                 let [sum, wsum] = acc[p];
-                if c == 0.0 || wsum <= 0.0 || !inside(p) {
-                    return f64::INFINITY;
-                }
-                let own = filters[p].peak();
-                let (loo_w, alpha) = (wsum - own * c, (own * c / wsum).clamp(0.0, 1.0));
-                // Below this share the others carry no weight: nothing to cross-validate.
-                if loo_w <= 1e-9 * wsum {
-                    return own_target[p] / norm[p];
-                }
-                let loo = (sum - luminance(film.reflected[p]) * own) / loo_w;
-                let cv = (loo - lx[p]).powi(2);
-                (alpha * alpha * own_target[p] + (1.0 - alpha).powi(2) * (cv - noise[p]).max(0.0)) / norm[p]
-            })
-            .collect();
-        risks.push(box3(w, h, &risk, rows));
-    }
-    risks.push(box3(
-        w,
-        h,
-        &(0..n)
-            .into_par_iter()
-            .map(|p| s2_target[p] / norm[p])
-            .collect::<Vec<_>>(),
-        rows,
-    ));
+                r[k] = if c == 0.0 || wsum <= 0.0 || !inside(p) {
+                    f64::INFINITY
+                } else {
+                    let own = filters[p].peak();
+                    let (loo_w, alpha) = (wsum - own * c, (own * c / wsum).clamp(0.0, 1.0));
+                    // Below this share the others carry no weight: nothing to cross-validate.
+                    if loo_w <= 1e-9 * wsum {
+                        own_target / norm[p]
+                    } else {
+                        let loo = (sum - luminance(film.reflected[p]) * own) / loo_w;
+                        let cv = (loo - px[p][PX_MEAN]).powi(2);
+                        (alpha * alpha * own_target + (1.0 - alpha).powi(2) * (cv - px[p][PX_NOISE]).max(0.0))
+                            / norm[p]
+                    }
+                };
+            }
+            r[boxed] = px[p][PX_MC_AT] / norm[p];
+            r
+        })
+        .collect();
+    let risks = box3(w, h, rows, |j| raw[j]);
     (0..n)
         .into_par_iter()
         .map(|p| {
-            let boxed = candidates.len();
+            let risk = &risks[p];
             let free = boxed - usize::from(stand_in);
             let mut best = boxed;
             for k in (0..free).filter(|_| inside(p)) {
-                if risks[k][p] < risks[best][p] {
+                if risk[k] < risk[best] {
                     best = k;
                 }
             }
             // With one sample the box's error is its neighbourhood's noise, which a
             // texture the pass is blind to inflates (`one_sample_variance`): the box stays.
             let own_variance = film.count[p] >= 2;
-            if best == boxed && free < boxed && own_variance && inside(p) && risks[free][p] < risks[boxed][p]
-            {
+            if best == boxed && free < boxed && own_variance && inside(p) && risk[free] < risk[boxed] {
                 best = free;
             }
             best as u8
         })
         .collect()
 }
+
+/// The columns of `choose`'s per-pixel quantities.
+const PX_MEAN: usize = 0;
+/// See [`PX_MEAN`].
+const PX_NOISE: usize = 1;
+/// See [`PX_MEAN`].
+const PX_MC_AT: usize = 2;
+/// See [`PX_MEAN`].
+const PX_NOISE_AT: usize = 3;
+/// The most candidates a pixel chooses among: every scale and the box.
+const MAX_CHOICES: usize = SCALES.len() + 1;
 
 /// The reach (px) of [`one_sample_variance`]'s differences: a 3×3 neighbourhood.
 const ONE_SAMPLE_REACH: i64 = 1;
@@ -328,9 +330,8 @@ const LEAST_OF_FOUR: f64 = 0.535;
 /// 3×3 means counts a texture the pass did not see as noise and blurs it (2.4× uniform
 /// sampling's error on a blind checker at 1 spp, against 1.1× with this), and the median
 /// absolute deviation misses the heavy tail of path-traced noise.
-fn one_sample_variance(film: &Film) -> Vec<f64> {
+fn one_sample_variance(film: &Film, own: &[f64]) -> Vec<f64> {
     const R: i64 = ONE_SAMPLE_REACH;
-    let own = film.variance();
     let (w, h) = (film.width as i64, film.height as i64);
     (0..w * h)
         .into_par_iter()
@@ -379,24 +380,32 @@ fn one_sample_variance(film: &Film) -> Vec<f64> {
         .collect()
 }
 
-/// The 3×3 mean of `v` in `rows` (fewer pixels at the borders; an infinite value stays
-/// infinite); 0 outside `rows`.
-fn box3(w: i64, h: i64, v: &[f64], rows: &Range<u32>) -> Vec<f64> {
+/// The 3×3 mean of `v(j)` in `rows`, each of its `K` values on its own (fewer pixels at
+/// the borders; an infinite value stays infinite); 0 outside `rows`.
+fn box3<const K: usize>(
+    w: i64,
+    h: i64,
+    rows: &Range<u32>,
+    v: impl Fn(usize) -> [f64; K] + Sync,
+) -> Vec<[f64; K]> {
     (0..w * h)
         .into_par_iter()
         .map(|i| {
             let (x, y) = (i % w, i / w);
             if !rows.contains(&(y as u32)) {
-                return 0.0;
+                return [0.0; K];
             }
-            let (mut s, mut k) = (0.0, 0.0);
+            let (mut s, mut k) = ([0.0; K], 0.0);
             for yy in (y - 1).max(0)..=(y + 1).min(h - 1) {
                 for xx in (x - 1).max(0)..=(x + 1).min(w - 1) {
-                    s += v[(yy * w + xx) as usize];
+                    let vj = v((yy * w + xx) as usize);
+                    for c in 0..K {
+                        s[c] += vj[c];
+                    }
                     k += 1.0;
                 }
             }
-            s / k
+            s.map(|sc| sc / k)
         })
         .collect()
 }
@@ -556,7 +565,7 @@ mod tests {
     #[test]
     fn one_sample_variance_reads_noise_not_edges() {
         let film = one_sample(32, 32, |x, _| if x < 16 { 0.2 } else { 1.0 });
-        let v = one_sample_variance(&film);
+        let v = one_sample_variance(&film, &film.variance());
         for y in 1..31 {
             for x in 14..18 {
                 assert_eq!(v[y * 32 + x], 0.0, "({x}, {y})");
@@ -569,7 +578,7 @@ mod tests {
         let film = one_sample(n as u32, n as u32, |x, y| {
             1.0 + 0.1 * gauss[(y * n as u32 + x) as usize]
         });
-        let v = one_sample_variance(&film);
+        let v = one_sample_variance(&film, &film.variance());
         let mean = v.iter().sum::<f64>() / v.len() as f64;
         // Unit-variance noise scaled by 0.1: the estimates' mean is its variance.
         assert!((mean / 0.01 - 1.0).abs() < 0.02, "{mean} against 0.01");
@@ -583,7 +592,7 @@ mod tests {
                 mixed.lum[i][0] = 2.0 * (1.0 + 0.1 * gauss[i] / 2f64.sqrt());
             }
         }
-        let v = one_sample_variance(&mixed);
+        let v = one_sample_variance(&mixed, &mixed.variance());
         let ones: Vec<f64> = (0..n * n)
             .filter(|&i| mixed.count[i] == 1)
             .map(|i| v[i])
@@ -597,7 +606,7 @@ mod tests {
         let mut film = film;
         film.count[100] = 2;
         film.lum[100] = [2.0, 2.5];
-        let v = one_sample_variance(&film);
+        let v = one_sample_variance(&film, &film.variance());
         assert_eq!(v[100], film.variance()[100]);
         assert!((v[100] - 0.5).abs() < 1e-12);
     }
