@@ -746,6 +746,26 @@ impl SceneFile {
                     format!("`{name}` = {value}: expected {what}")
                 };
                 at = value_at();
+            } else if message.starts_with("Expected opening `(`")
+                && let Some((name, _, value)) = field()
+            {
+                // A tuple or a struct's fields belong here: `position: 3.9`.
+                let what = match message.split_once(" for struct `") {
+                    Some((_, t)) => format!("`{}`'s fields in parentheses, `(name: value, …)`", t.split('`').next().unwrap_or("")),
+                    None => "values in parentheses, `(…)`".to_string(),
+                };
+                message = format!("`{name}` = {}: expected {what}", cov_core::echo(&value));
+                at = value_at();
+            } else if let Some(tail) = message.strip_prefix("Unexpected field named `")
+                && let Some((found, rest)) = tail.split_once('`')
+                && found.starts_with(|c: char| c.is_ascii_uppercase())
+                && let Some(owner) = rest.strip_prefix(" in `").and_then(|o| o.split('`').next())
+            {
+                // Every field is in lower case: a name in capitals (`Sphere`) is the next
+                // entry of a list, read as a field because a `)` is missing before it.
+                message = format!(
+                    "found `{found}` among `{owner}`'s fields: is the `)` that closes the `{owner}` before it missing?"
+                );
             } else if let Some(words) = tuple_words(text, line, col, &message) {
                 message = words;
             } else if message.starts_with("Expected") && !message.contains(" found ") {

@@ -488,6 +488,26 @@ fn a_wrong_value_is_pointed_at_where_it_starts() {
         let e = error(&scene(&[("FOV", fov)]));
         assert!(e.starts_with(want), "fov {fov}: {e}");
     }
+    // A number where parentheses belong: said of the field, at the value.
+    let e = error(&scene(&[("LOOK", "0.5")]));
+    assert!(
+        e.starts_with("2:50: `look_at` = 0.5: expected values in parentheses"),
+        "{e}"
+    );
+    let e = error(&scene(&[("LENS", ", lens: 0.04")]));
+    assert!(
+        e.contains("`lens` = 0.04: expected `Lens`'s fields in parentheses"),
+        "{e}"
+    );
+    // An entry of a list read as a field, because the one before it is not closed.
+    let e = error(&scene(&[(
+        "SHAPE",
+        "Sphere(center: (1.0, 0.5, 0.0), radius: 0.5, material: \"w\",\n        Sphere(center: (2.0, 0.5, 0.0), radius: 0.5, material: \"w\")",
+    )]));
+    assert!(
+        e.starts_with("6:9: found `Sphere` among `Sphere`'s fields: is the `)` that closes the `Sphere` before it missing?"),
+        "{e}"
+    );
     // A field written twice: said in the scene's words, at the second one.
     let e = error(&scene(&[("FOV", "40.0, fov: 30.0")]));
     assert!(
