@@ -73,6 +73,36 @@ fn every_bundled_scene_renders_the_same_on_one_and_two_threads() {
     }
 }
 
+/// The scenes kept as known limits (examples/limits) load, their covariance maps are
+/// finite and PSD, and they render finite and not black.
+#[test]
+fn every_limit_scene_renders() {
+    let dir = scenes().join("../limits");
+    let mut n = 0;
+    for entry in std::fs::read_dir(&dir).expect("examples/limits") {
+        let path = entry.expect("entry").path();
+        if path.extension().is_none_or(|e| e != "ron") {
+            continue;
+        }
+        let world = World::load(&path)
+            .unwrap_or_else(|e| panic!("{e}"))
+            .with_resolution(16, 12);
+        let maps = covariance_maps(&world, 1, 4, 7, None).unwrap_or_else(|e| panic!("{e}"));
+        for p in &maps.pixels {
+            finite_and_psd(p, &path.display().to_string());
+        }
+        let img = render(&world, 2, 7);
+        assert!(
+            img.pixels.iter().all(|p| p.is_finite() && p.min_element() >= 0.0),
+            "{}",
+            path.display()
+        );
+        assert!(img.pixels.iter().any(|p| p.max_element() > 0.0), "{}: black", path.display());
+        n += 1;
+    }
+    assert!(n >= 2, "examples/limits holds {n} scenes");
+}
+
 /// A diffuse plane of albedo ρ under a sphere light of radiance L and radius R whose
 /// centre is D above the point seen: the irradiance is `π L (R/D)²`, so the radiance
 /// leaving the plane is `ρ L (R/D)²`. The estimator (MIS direct light plus a bounce that
