@@ -239,30 +239,26 @@ fn field_span(
         match chars[i] {
             ')' | ']' | '}' => depth += 1,
             // `Some(` opens no level of its own: the field is the one it is the value of.
-            '(' if depth == 0 && word_before(chars, i) == "Some" => {}
+            '(' if depth == 0 && {
+                let (a, b) = word_before(chars, i);
+                chars[a..b] == ['S', 'o', 'm', 'e']
+            } => {}
             '(' | '[' | '{' if depth == 0 => return None,
             '(' | '[' | '{' => depth -= 1,
             ':' if depth == 0 => break i,
             _ => {}
         }
     };
-    let mut end = colon;
-    while end > 0 && chars[end - 1].is_whitespace() {
-        end -= 1;
-    }
-    let mut start = end;
-    while start > 0 && (chars[start - 1].is_alphanumeric() || chars[start - 1] == '_') {
-        start -= 1;
-    }
+    let (start, end) = word_before(chars, colon);
     if start == end || !(chars[start].is_alphabetic() || chars[start] == '_') {
         return None;
     }
     Some((start, end, colon))
 }
 
-/// The word (letters, digits, `_`) that ends right before index `i` of `chars`, blanks
-/// between them skipped.
-fn word_before(chars: &[char], i: usize) -> String {
+/// The indices of the start and the end of the word (letters, digits, `_`) that ends
+/// right before index `i` of `chars`, blanks between them skipped (empty: no word).
+fn word_before(chars: &[char], i: usize) -> (usize, usize) {
     let mut end = i;
     while end > 0 && chars[end - 1].is_whitespace() {
         end -= 1;
@@ -271,7 +267,7 @@ fn word_before(chars: &[char], i: usize) -> String {
     while start > 0 && (chars[start - 1].is_alphanumeric() || chars[start - 1] == '_') {
         start -= 1;
     }
-    chars[start..end].iter().collect()
+    (start, end)
 }
 
 /// The value written from `v` in `written` (`chars`: its [`code_of`], comments blanked

@@ -97,7 +97,11 @@ fn every_limit_scene_renders() {
             "{}",
             path.display()
         );
-        assert!(img.pixels.iter().any(|p| p.max_element() > 0.0), "{}: black", path.display());
+        assert!(
+            img.pixels.iter().any(|p| p.max_element() > 0.0),
+            "{}: black",
+            path.display()
+        );
         n += 1;
     }
     assert!(n >= 2, "examples/limits holds {n} scenes");

@@ -477,43 +477,42 @@ fn small_inputs_cannot_ask_for_unbounded_work() {
 /// position: after a sign, inside a number, or at the blank before a string.
 #[test]
 fn a_wrong_value_is_pointed_at_where_it_starts() {
-    // `camera: (position: (0.0, 1.0, 3.0), look_at: LOOK, fov: FOV, …`: FOV's value is
-    // written from column 72 of line 2.
-    for (fov, want) in [
-        ("\"wide\"", "2:72: `fov` = \"wide\": expected a number"),
-        ("-40.0", "2:72: `fov` must be finite and > 0, got -40"),
-        ("0x28", "2:72: `fov` = 0x28: a hexadecimal number"),
-        ("   true", "2:75: `fov` = true: expected a number"),
+    // `camera: (position: (0.0, 1.0, 3.0), look_at: LOOK, fov: FOV, …`: LOOK's value is
+    // written from column 50 of line 2, FOV's from column 72.
+    let unclosed = "Sphere(center: (1.0, 0.5, 0.0), radius: 0.5, material: \"w\",\n        \
+                    Sphere(center: (2.0, 0.5, 0.0), radius: 0.5, material: \"w\")";
+    for (part, value, want) in [
+        ("FOV", "\"wide\"", "2:72: `fov` = \"wide\": expected a number"),
+        ("FOV", "-40.0", "2:72: `fov` must be finite and > 0, got -40"),
+        ("FOV", "0x28", "2:72: `fov` = 0x28: a hexadecimal number"),
+        ("FOV", "   true", "2:75: `fov` = true: expected a number"),
+        // A number where parentheses belong: said of the field, at the value.
+        (
+            "LOOK",
+            "0.5",
+            "2:50: `look_at` = 0.5: expected values in parentheses",
+        ),
+        (
+            "LENS",
+            ", lens: 0.04",
+            "2:105: `lens` = 0.04: expected `Lens`'s fields in parentheses",
+        ),
+        // An entry of a list read as a field, because the one before it is not closed.
+        (
+            "SHAPE",
+            unclosed,
+            "6:9: found `Sphere` among `Sphere`'s fields: is the `)` that closes the `Sphere` before it missing?",
+        ),
+        // A field written twice: said in the scene's words, at the second one.
+        (
+            "FOV",
+            "40.0, fov: 30.0",
+            "2:78: `fov` is given twice in `Camera`: remove one",
+        ),
     ] {
-        let e = error(&scene(&[("FOV", fov)]));
-        assert!(e.starts_with(want), "fov {fov}: {e}");
+        let e = error(&scene(&[(part, value)]));
+        assert!(e.starts_with(want), "{part} = {value}: {e}");
     }
-    // A number where parentheses belong: said of the field, at the value.
-    let e = error(&scene(&[("LOOK", "0.5")]));
-    assert!(
-        e.starts_with("2:50: `look_at` = 0.5: expected values in parentheses"),
-        "{e}"
-    );
-    let e = error(&scene(&[("LENS", ", lens: 0.04")]));
-    assert!(
-        e.contains("`lens` = 0.04: expected `Lens`'s fields in parentheses"),
-        "{e}"
-    );
-    // An entry of a list read as a field, because the one before it is not closed.
-    let e = error(&scene(&[(
-        "SHAPE",
-        "Sphere(center: (1.0, 0.5, 0.0), radius: 0.5, material: \"w\",\n        Sphere(center: (2.0, 0.5, 0.0), radius: 0.5, material: \"w\")",
-    )]));
-    assert!(
-        e.starts_with("6:9: found `Sphere` among `Sphere`'s fields: is the `)` that closes the `Sphere` before it missing?"),
-        "{e}"
-    );
-    // A field written twice: said in the scene's words, at the second one.
-    let e = error(&scene(&[("FOV", "40.0, fov: 30.0")]));
-    assert!(
-        e.starts_with("2:78: `fov` is given twice in `Camera`: remove one"),
-        "{e}"
-    );
 }
 
 /// A path's depth is a count the user controls: 1 to 32, refused where it is written,
