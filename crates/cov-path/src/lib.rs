@@ -41,5 +41,5 @@ pub use path::{
     whole_number_at,
 };
 pub use registry::{Entry, Registry};
-pub use scan::{element_at, field_at, odd_space_before, value_position};
+pub use scan::{blank_or_comment, element_at, field_at, odd_space_before, value_position};
 pub use source::Source;

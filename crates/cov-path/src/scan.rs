@@ -178,6 +178,15 @@ pub(crate) fn field_position(text: &str, line: usize, col: usize, name: &str) ->
     Some(pos[at])
 }
 
+/// Whether `text` holds nothing but blanks and comments (a leading byte-order mark not
+/// counted).
+pub fn blank_or_comment(text: &str) -> bool {
+    let text = text.strip_prefix('\u{feff}').unwrap_or(text);
+    code_of(&text.chars().collect::<Vec<char>>())
+        .iter()
+        .all(|c| c.is_whitespace())
+}
+
 /// The field whose value ron stopped at in RON `text` (a path's or a scene's), `(line,
 /// col)` (1-based, as ron reports it) being in that value or just before it, where ron
 /// reports a value of the wrong type, or at the closing parenthesis of a tuple it

@@ -268,12 +268,19 @@ where
             f.write_str("a map of names to definitions")
         }
         fn visit_map<A: serde::de::MapAccess<'de>>(self, mut map: A) -> Result<Self::Value, A::Error> {
-            let mut out = BTreeMap::new();
+            let mut out: BTreeMap<At<String>, V> = BTreeMap::new();
             while let Some((name, value)) = map.next_entry::<At<String>, V>()? {
-                let echo = crate::echo(&name.value);
-                if out.insert(name, value).is_some() {
-                    return Err(A::Error::custom(format!("`{echo}` is defined twice")));
+                if let Some((first, _)) = out.get_key_value(&name) {
+                    // Positioned by `SceneFile::parse` at the second name, the first's
+                    // place said ([`TWICE_MARK`]).
+                    return Err(A::Error::custom(format!(
+                        "{TWICE_MARK}{} {}{TWICE_MARK}`{}` is defined twice",
+                        name.ordinal,
+                        first.ordinal,
+                        crate::echo(&name.value)
+                    )));
                 }
+                out.insert(name, value);
             }
             Ok(out)
         }
@@ -286,7 +293,7 @@ where
 #[serde(deny_unknown_fields, rename = "Camera")]
 pub struct CameraDesc {
     /// Centre of the lens (m).
-    pub position: V3,
+    pub position: At<V3>,
     /// Point aimed at (m).
     pub look_at: At<V3>,
     /// Up vector (default +y).
@@ -562,6 +569,11 @@ impl<T: Ord> Ord for At<T> {
 /// The message with which a located parse stops (never shown to a user).
 const LOCATE_MARK: &str = "\u{0}covtrace-locate";
 
+/// Encloses, at the start of a name-defined-twice message, the two names' [`At`]
+/// numbers (the second's, then the first's), which `SceneFile::parse` turns into
+/// positions (never shown to a user).
+const TWICE_MARK: &str = "\u{0}covtrace-twice";
+
 thread_local! {
     /// While parsing: the number the next [`At`] gets, and the one to stop at.
     static PROBE: std::cell::Cell<(u32, Option<u32>)> = const { std::cell::Cell::new((0, None)) };
@@ -625,6 +637,26 @@ fn whole_words(text: &str, line: usize, col: usize) -> Option<String> {
         (name, None, value) => format!("`{name}` = {}: {WORDS}", cov_core::echo(&value)),
         (name, Some(k), value) => format!("`{name}`: value {} = {}: {WORDS}", k + 1, cov_core::echo(&value)),
     })
+}
+
+/// Whether a check's message `m` (`…, got N`) was given the whole part of `written`,
+/// a decimal number: the parser reads `0.5` where a whole number belongs as 0, and a
+/// bound refuses the 0 before the parser reaches the `.`.
+fn truncated(m: &str, written: &str) -> bool {
+    let Ok(value) = written.trim().parse::<f64>() else {
+        return false;
+    };
+    let got = m
+        .rsplit_once("got ")
+        .and_then(|(_, g)| g.trim().parse::<f64>().ok());
+    value.is_finite() && value.fract() != 0.0 && got.is_some_and(|g| g == value.trunc())
+}
+
+/// Whether `written` is a number too large for a float (`1e400`), which the parser reads
+/// as infinite: a check would then say "got inf" of a value the user did not write.
+fn overflows(written: &str) -> bool {
+    let w = written.trim();
+    !w.to_ascii_lowercase().contains("inf") && w.parse::<f64>().is_ok_and(f64::is_infinite)
 }
 
 /// ron's message `message` at `(line, col)` of `text` said of a tuple's field, when it
@@ -702,6 +734,32 @@ impl SceneFile {
             // Where the message points: ron's position, or the start of the value it is
             // about (ron stops after a sign, inside a number or before a string's blank).
             let mut at = (line, col);
+            if let Some((ordinals, words)) = message
+                .strip_prefix(TWICE_MARK)
+                .and_then(|m| m.split_once(TWICE_MARK))
+            {
+                // A name defined twice: at the second, the first's place said.
+                let mut place = ordinals
+                    .split(' ')
+                    .filter_map(|o| o.parse().ok())
+                    .map(|o| Self::locate(text, o));
+                let (second, first) = (place.next().flatten(), place.next().flatten());
+                return SceneError {
+                    file: file.to_string(),
+                    at: Some(second.unwrap_or((line, col))),
+                    message: cov_core::one_line(&match first {
+                        Some((l, c)) => format!("{words} (first at {l}:{c})"),
+                        None => words.to_string(),
+                    }),
+                };
+            }
+            if message.starts_with("Expected opening `(` for struct `Scene`") && cov_path::blank_or_comment(text) {
+                return SceneError {
+                    file: file.to_string(),
+                    at: Some((line, col)),
+                    message: "the file holds no scene: expected `Scene(…)`".into(),
+                };
+            }
             let field = || cov_path::field_at(text, line, col);
             let value_at = || cov_path::value_position(text, line, col).unwrap_or((line, col));
             // `0x1` where a decimal belongs: ron reads the `0` (so a checked type refuses 0,
@@ -726,6 +784,24 @@ impl SceneFile {
                     .map(|o| format!(" in {o}"))
                     .unwrap_or_default();
                 message = format!("`{name}` is given twice{owner}: remove one");
+            } else if let ron::Error::Message(m) = &e.code
+                && let Some((_, _, value)) = field()
+                && truncated(m, &value)
+                && let Some(words) = whole_words(text, line, col)
+            {
+                // A decimal where a whole number belongs, read as its whole part (`0.5`
+                // as 0), which a bound then refused: said as the decimal it is.
+                message = words;
+                at = value_at();
+            } else if let ron::Error::Message(_) = &e.code
+                && let Some((name, _, value)) = field()
+                && overflows(&value)
+            {
+                message = format!(
+                    "`{name}` = {}: beyond the largest number a float holds (about 1.8e308)",
+                    cov_core::echo(&value)
+                );
+                at = value_at();
             } else if let ron::Error::Message(m) = &e.code
                 && let Some((name, ..)) = field()
             {

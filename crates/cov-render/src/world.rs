@@ -522,13 +522,24 @@ type Failure = (u32, String);
 
 /// The camera of a description.
 fn camera(c: &CameraDesc) -> Result<Camera, Failure> {
-    let position = v(c.position);
+    let position = v(c.position.value);
+    if !position.is_finite() || position.abs().max_element() > MAX_COORD {
+        return Err((
+            c.position.ordinal,
+            format!(
+                "`position` must lie within ±{MAX_COORD:e} m of the origin, as every point of the scene does, got ({}, {}, {})",
+                cov_core::num(position.x),
+                cov_core::num(position.y),
+                cov_core::num(position.z)
+            ),
+        ));
+    }
     let aim = v(c.look_at.value);
     if !aim.is_finite() || aim.abs().max_element() > MAX_COORD {
         return Err((
             c.look_at.ordinal,
             format!(
-                "look_at must lie within ±{MAX_COORD:e} m of the origin, as every point of the scene does, got ({}, {}, {})",
+                "`look_at` must lie within ±{MAX_COORD:e} m of the origin, as every point of the scene does, got ({}, {}, {})",
                 cov_core::num(aim.x),
                 cov_core::num(aim.y),
                 cov_core::num(aim.z)
@@ -996,7 +1007,7 @@ fn lights(desc: &SceneFile, prims: &mut Vec<Prim>) -> Result<Vec<Light>, Failure
                 if cr.length() <= 0.0 {
                     return Err((
                         edge_u.ordinal,
-                        "a Rect light's edges are parallel (zero area)".into(),
+                        "a Rect light's `edge_u` and `edge_v` span no area (one is zero, or they are parallel)".into(),
                     ));
                 }
                 lights.push(Light::Rect {
@@ -1224,7 +1235,11 @@ fn shapes(
             } => {
                 let (eu, ev) = (v(edge_u.value), v(*edge_v));
                 if eu.cross(ev).length() <= 0.0 {
-                    return Err((edge_u.ordinal, "a Quad's edges are parallel (zero area)".into()));
+                    return Err((
+                        edge_u.ordinal,
+                        "a Quad's `edge_u` and `edge_v` span no area (one is zero, or they are parallel)"
+                            .into(),
+                    ));
                 }
                 for (tri, uv) in quad_triangles(v(*corner), eu, ev).into_iter().zip(QUAD_UV) {
                     push(Shape::triangle(tri, None, Some(uv)));

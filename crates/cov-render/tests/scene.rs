@@ -51,7 +51,7 @@ fn error(text: &str) -> String {
 
 #[test]
 fn checks_after_parsing_point_at_the_value() {
-    let cases: [(&[(&str, &str)], &str); 14] = [
+    let cases: [(&[(&str, &str)], &str); 15] = [
         (
             &[("LOOK", "(0.0, 1.0, 3.0)")],
             "2:50: the camera looks at its own position",
@@ -60,7 +60,13 @@ fn checks_after_parsing_point_at_the_value() {
         // message blamed `up`.
         (
             &[("LOOK", "(0.0, 0.9, -1e200)")],
-            "2:50: look_at must lie within ±1e12 m of the origin",
+            "2:50: `look_at` must lie within ±1e12 m of the origin",
+        ),
+        // Beyond it by the camera's own position: it used to be read as looking straight
+        // up (the view direction overflowed), at `look_at`.
+        (
+            &[("(position: (0.0, 1.0, 3.0)", "(position: (0.0, 1e308, 3.0)")],
+            "2:24: `position` must lie within ±1e12 m of the origin",
         ),
         // Squared in the lens equation: past 1e154 it overflowed into a black image.
         (
@@ -105,14 +111,14 @@ fn checks_after_parsing_point_at_the_value() {
                 "LIGHTS",
                 "[Rect(corner: (0.0, 2.0, 0.0), edge_u: (1.0, 0.0, 0.0), edge_v: (2.0, 0.0, 0.0), radiance: (1.0, 1.0, 1.0))]",
             )],
-            "4:52: a Rect light's edges are parallel",
+            "4:52: a Rect light's `edge_u` and `edge_v` span no area",
         ),
         (
             &[(
                 "SHAPE",
                 r#"Quad(corner: (0.0, 0.0, 0.0), edge_u: (0.0, 0.0, 0.0), edge_v: (1.0, 0.0, 0.0), material: "w")"#,
             )],
-            "5:113: a Quad's edges are parallel",
+            "5:113: a Quad's `edge_u` and `edge_v` span no area",
         ),
         // The second shape names a material that the first one's text also contains
         // (`"w"` inside `"white"`): the position is the second shape's own.
@@ -370,13 +376,13 @@ fn what_single_precision_cannot_hold_is_refused() {
     );
 }
 
-/// A material or texture name given twice is an error where the second definition is,
-/// not a silent replacement of the first.
+/// A material or texture name given twice is an error at the second name, with the
+/// first's place, not a silent replacement of the first.
 #[test]
 fn a_name_defined_twice_is_refused() {
     let twice = scene(&[("MAT", r#""w": Diffuse(albedo: (0.9, 0.1, 0.1))"#)]);
     let e = error(&twice);
-    assert!(e.starts_with("3:94: `w` is defined twice"), "{e}");
+    assert!(e.starts_with("3:57: `w` is defined twice (first at 3:18)"), "{e}");
     let textures = BASE.replace(
         "    materials:",
         "    textures: { \"t\": Checker(checks: (2, 2), a: (1.0, 1.0, 1.0), b: (0.0, 0.0, 0.0)), \"t\": Stripes(count: 2, duty: 0.5, a: (1.0, 1.0, 1.0), b: (0.0, 0.0, 0.0)) },\n    materials:",
@@ -512,6 +518,35 @@ fn a_wrong_value_is_pointed_at_where_it_starts() {
     ] {
         let e = error(&scene(&[(part, value)]));
         assert!(e.starts_with(want), "{part} = {value}: {e}");
+    }
+}
+
+/// A decimal below 1 where a whole number belongs is not read as 0; a file of comments
+/// alone holds no scene.
+#[test]
+fn decimals_and_empty_files_are_said_as_written() {
+    let e = error(&scene(&[("width: 8", "width: 0.5")]));
+    assert!(
+        e.starts_with("2:85: `width` = 0.5: expected a whole number, found a decimal number"),
+        "{e}"
+    );
+    // A decimal the parser refuses as a number of its own type is said as before.
+    let e = error(&scene(&[("FOV", "0.5, width: 8.5")]).replace(", width: 8, height", ", height"));
+    assert!(e.contains("`width` = 8.5: expected a whole number"), "{e}");
+    // A number too large for a float is said as written, not as infinity.
+    let e = error(&scene(&[("FOV", "1e400")]));
+    assert!(
+        e.starts_with("2:72: `fov` = 1e400: beyond the largest number a float holds"),
+        "{e}"
+    );
+    let e = error(&scene(&[("FOV", "inf")]));
+    assert!(e.contains("`fov` must be finite"), "{e}");
+    for text in ["// only a comment\n", "  \n\n", "\u{feff}/* a block */"] {
+        let e = error(text);
+        assert!(
+            e.contains("the file holds no scene: expected `Scene(…)`"),
+            "{text:?}: {e}"
+        );
     }
 }
 
