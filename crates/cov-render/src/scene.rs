@@ -456,7 +456,7 @@ pub enum LightDesc {
     /// A parallelogram emitting on the side of `edge_u × edge_v`.
     Rect {
         /// A corner (m).
-        corner: V3,
+        corner: At<V3>,
         /// First edge (m).
         edge_u: At<V3>,
         /// Second edge (m).
@@ -467,7 +467,7 @@ pub enum LightDesc {
     /// A sphere emitting outwards.
     Sphere {
         /// Centre (m).
-        center: V3,
+        center: At<V3>,
         /// Radius (m).
         radius: At<Positive>,
         /// Radiance.
@@ -482,7 +482,7 @@ pub enum ShapeDesc {
     /// A sphere.
     Sphere {
         /// Centre at time 0 (m).
-        center: V3,
+        center: At<V3>,
         /// Radius (m).
         radius: At<Positive>,
         /// Material name.
@@ -500,7 +500,7 @@ pub enum ShapeDesc {
     /// A parallelogram.
     Quad {
         /// A corner (m).
-        corner: V3,
+        corner: At<V3>,
         /// First edge (m).
         edge_u: At<V3>,
         /// Second edge (m).

@@ -476,7 +476,6 @@ impl World {
         let mut prims = Vec::new();
         let (t0, t1) = camera.shutter.unwrap_or((0.0, 0.0));
         let lights = lights(&desc, &mut prims).map_err(|(o, m)| at(o, m))?;
-        within_reach(&prims, 0, t0, t1, desc.lights.ordinal).map_err(|(o, m)| at(o, m))?;
         let mut boxes = SharedBoxes::default();
         boxes
             .add(&prims, 0, (t0, t1), desc.lights.ordinal)
@@ -995,6 +994,11 @@ fn lights(desc: &SceneFile, prims: &mut Vec<Prim>) -> Result<Vec<Light>, Failure
     let mut lights = Vec::new();
     for l in &desc.lights.value {
         let index = lights.len() as u32;
+        let from = prims.len();
+        let place = match l {
+            LightDesc::Rect { corner, .. } => corner.ordinal,
+            LightDesc::Sphere { center, .. } => center.ordinal,
+        };
         match l {
             LightDesc::Rect {
                 corner,
@@ -1002,7 +1006,7 @@ fn lights(desc: &SceneFile, prims: &mut Vec<Prim>) -> Result<Vec<Light>, Failure
                 edge_v,
                 radiance,
             } => {
-                let (c0, eu, ev) = (v(*corner), v(edge_u.value), v(*edge_v));
+                let (c0, eu, ev) = (v(corner.value), v(edge_u.value), v(*edge_v));
                 let cr = eu.cross(ev);
                 if cr.length() <= 0.0 {
                     return Err((
@@ -1034,13 +1038,13 @@ fn lights(desc: &SceneFile, prims: &mut Vec<Prim>) -> Result<Vec<Light>, Failure
             } => {
                 let radius = radius.value;
                 lights.push(Light::Sphere {
-                    center: v(*center),
+                    center: v(center.value),
                     radius: radius.0,
                     radiance: DVec3::from_array(radiance.0),
                 });
                 prims.push(Prim {
                     shape: Shape::Sphere {
-                        center: v(*center),
+                        center: v(center.value),
                         radius: radius.0,
                         spin: DVec3::ZERO,
                     },
@@ -1050,6 +1054,8 @@ fn lights(desc: &SceneFile, prims: &mut Vec<Prim>) -> Result<Vec<Light>, Failure
                 });
             }
         }
+        // Lights do not move: their reach is the same at every instant.
+        within_reach(prims, from, 0.0, 0.0, place, "light")?;
     }
     if lights.is_empty() {
         return Err((
@@ -1082,8 +1088,8 @@ fn large_enough(desc: &SceneFile) -> Result<(), Failure> {
                 edge_u,
                 edge_v,
                 ..
-            } => sizes.extend(edges("Rect light's edge", *corner, edge_u, *edge_v)),
-            LightDesc::Sphere { center, radius, .. } => sizes.push(sphere(center, radius)),
+            } => sizes.extend(edges("Rect light's edge", corner.value, edge_u, *edge_v)),
+            LightDesc::Sphere { center, radius, .. } => sizes.push(sphere(&center.value, radius)),
         }
     }
     for s in &desc.shapes {
@@ -1093,8 +1099,8 @@ fn large_enough(desc: &SceneFile) -> Result<(), Failure> {
                 edge_u,
                 edge_v,
                 ..
-            } => sizes.extend(edges("Quad's edge", *corner, edge_u, *edge_v)),
-            ShapeDesc::Sphere { center, radius, .. } => sizes.push(sphere(center, radius)),
+            } => sizes.extend(edges("Quad's edge", corner.value, edge_u, *edge_v)),
+            ShapeDesc::Sphere { center, radius, .. } => sizes.push(sphere(&center.value, radius)),
             ShapeDesc::Mesh { .. } => {}
         }
     }
@@ -1124,20 +1130,27 @@ fn at_least(least: f64) -> String {
     )
 }
 
-/// `Err` at `ordinal` if a primitive of `prims[from..]` reaches past [`MAX_COORD`] over
-/// the shutter `t0..t1`.
-fn within_reach(prims: &[Prim], from: usize, t0: f64, t1: f64, ordinal: u32) -> Result<(), Failure> {
+/// `Err` at `ordinal` if a primitive of `prims[from..]` (a `what`: sphere, quad, mesh,
+/// light) reaches past [`MAX_COORD`] over the shutter `t0..t1`.
+fn within_reach(
+    prims: &[Prim],
+    from: usize,
+    t0: f64,
+    t1: f64,
+    ordinal: u32,
+    what: &str,
+) -> Result<(), Failure> {
     let reach = crate::geometry::reach(&prims[from..], t0, t1);
     if reach <= MAX_COORD {
         return Ok(());
     }
-    Err((ordinal, beyond_reach(reach)))
+    Err((ordinal, beyond_reach(what, reach)))
 }
 
-/// What [`within_reach`] says of a shape that reaches `reach` m from the origin.
-fn beyond_reach(reach: f64) -> String {
+/// What [`within_reach`] says of a `what` that reaches `reach` m from the origin.
+fn beyond_reach(what: &str, reach: f64) -> String {
     format!(
-        "this shape reaches {} m from the origin (over the shutter, if it moves): the renderer's single-precision BVH holds ±{MAX_COORD:e} m",
+        "this {what} reaches {} m from the origin (over the shutter, if it moves): the renderer's single-precision BVH holds ±{MAX_COORD:e} m",
         cov_core::approx(reach)
     )
 }
@@ -1222,7 +1235,7 @@ fn shapes(
                     None => DVec3::ZERO,
                 };
                 push(Shape::Sphere {
-                    center: v(*center),
+                    center: v(center.value),
                     radius: radius.value.0,
                     spin,
                 })
@@ -1241,7 +1254,7 @@ fn shapes(
                             .into(),
                     ));
                 }
-                for (tri, uv) in quad_triangles(v(*corner), eu, ev).into_iter().zip(QUAD_UV) {
+                for (tri, uv) in quad_triangles(v(corner.value), eu, ev).into_iter().zip(QUAD_UV) {
                     push(Shape::triangle(tri, None, Some(uv)));
                 }
             }
@@ -1329,7 +1342,7 @@ fn shapes(
                 // least size out there instead, which says nothing of the `translate`).
                 let far = lo.abs().max(hi.abs()).max_element();
                 if far > MAX_COORD {
-                    return Err((obj.ordinal, beyond_reach(far)));
+                    return Err((obj.ordinal, beyond_reach("mesh", far)));
                 }
                 let (size, least) = (
                     (hi - lo).max_element(),
@@ -1350,11 +1363,13 @@ fn shapes(
                 }
             }
         }
-        let ordinal = match s {
-            ShapeDesc::Mesh { obj, .. } => obj.ordinal,
-            ShapeDesc::Sphere { material, .. } | ShapeDesc::Quad { material, .. } => material.ordinal,
+        // Where the shape is placed: a sphere's centre, a quad's corner, a mesh's file.
+        let (ordinal, what) = match s {
+            ShapeDesc::Mesh { obj, .. } => (obj.ordinal, "mesh"),
+            ShapeDesc::Sphere { center, .. } => (center.ordinal, "sphere"),
+            ShapeDesc::Quad { corner, .. } => (corner.ordinal, "quad"),
         };
-        within_reach(prims, from, t0, t1, ordinal)?;
+        within_reach(prims, from, t0, t1, ordinal, what)?;
         boxes.add(prims, from, (t0, t1), ordinal)?;
     }
     Ok(any_velocity)

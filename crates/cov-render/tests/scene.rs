@@ -241,8 +241,8 @@ fn refused_values_name_their_field() {
     );
 }
 
-/// What single precision cannot hold is refused where it is written: a shape or a light
-/// past `MAX_COORD` (at rest or by its motion over the shutter), a colour past
+/// What single precision cannot hold is refused where it is written (a sphere or a
+/// sphere light at its centre): a shape or a light past `MAX_COORD` (at rest or by its motion over the shutter), a colour past
 /// `MAX_COLOUR` (printed compactly); and a frame that moves a shape past it is an error,
 /// not a broken BVH.
 #[test]
@@ -252,13 +252,13 @@ fn what_single_precision_cannot_hold_is_refused() {
         r#"Sphere(center: (2e12, 0.5, 0.0), radius: 0.5, material: "w")"#,
     )]);
     let e = error(&far);
-    assert!(e.starts_with("5:131: this shape reaches 2e12 m"), "{e}");
+    assert!(e.starts_with("5:90: this sphere reaches 2e12 m"), "{e}");
     let light = scene(&[(
         "LIGHTS",
         "[Sphere(center: (0.0, 2.0, -5e12), radius: 0.2, radiance: (1.0, 1.0, 1.0))]",
     )]);
     assert!(
-        error(&light).starts_with("4:13: this shape reaches 5e12 m"),
+        error(&light).starts_with("4:29: this light reaches 5e12 m"),
         "{}",
         error(&light)
     );
@@ -908,7 +908,7 @@ fn a_mesh_placed_out_of_reach_says_so() {
             .unwrap_err()
             .to_string();
         assert!(
-            e.contains(&format!("this shape reaches {x} m from the origin")) && e.contains("holds ±1e12 m"),
+            e.contains(&format!("this mesh reaches {x} m from the origin")) && e.contains("holds ±1e12 m"),
             "{e}"
         );
     }
@@ -922,9 +922,9 @@ fn copies_of_one_shape_in_one_place_are_refused() {
         |n: usize| vec![r#"Sphere(center: (0.0, 0.5, 0.0), radius: 0.5, material: "w")"#; n].join(", ");
     // With the base scene's own sphere, 256 copies make 257 on one box.
     let e = error(&scene(&[("SHAPE", &copies(256))]));
-    // The material of the 257th sphere on the line: the base's at column 69, then one
+    // The centre of the 257th sphere on the line: the base's at column 29, then one
     // every 61 characters.
-    let col = 69 + 61 * 256;
+    let col = 29 + 61 * 256;
     assert!(
         e.starts_with(&format!(
             "5:{col}: more than 256 shapes, lights or triangles lie exactly on one another"
