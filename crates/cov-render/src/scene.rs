@@ -608,26 +608,54 @@ fn line_start(text: &str, line: usize) -> Option<usize> {
 
 /// What the text holds at `line:col` (1-based, as the parser reports it), quoted: the word
 /// or number that starts there, or its one character (at most 24 characters, on one line),
-/// or "the end of the file".
-fn found_at(text: &str, line: usize, col: usize) -> String {
-    let rest = line_start(text, line).and_then(|s| text.get(s..)).map(|l| {
-        l.chars()
-            .skip(col.saturating_sub(1))
-            .skip_while(|c| *c == ' ' || *c == '\t')
-    });
-    let mut chars = match rest {
-        Some(c) => c.peekable(),
-        None => return "the end of the file".into(),
+/// or "the end of the file"; and the column where it starts (ron may stop at the blank
+/// before it).
+fn found_at(text: &str, line: usize, col: usize) -> (String, usize) {
+    let Some(l) = line_start(text, line).and_then(|s| text.get(s..)) else {
+        return ("the end of the file".into(), col);
     };
+    let blanks = l
+        .chars()
+        .skip(col.saturating_sub(1))
+        .take_while(|c| *c == ' ' || *c == '\t')
+        .count();
+    let mut chars = l.chars().skip(col.saturating_sub(1) + blanks).peekable();
+    let at = col + blanks;
     let word = |c: &char| c.is_alphanumeric() || matches!(*c, '_' | '.' | '-' | '+');
     let token: String = match chars.peek() {
-        None => return "the end of the file".into(),
-        Some('\n' | '\r') => return "the end of the line".into(),
+        None => return ("the end of the file".into(), at),
+        Some('\n' | '\r') => return ("the end of the line".into(), at),
         Some(c) if word(c) => chars.take_while(word).take(24).collect(),
         Some(_) => chars.take(1).collect(),
     };
-    format!("`{token}`")
+    (format!("`{token}`"), at)
 }
+
+/// Where the value of the field whose name is at `name` (line, column) starts: the first
+/// character after its colon that is not blank.
+fn after_colon(text: &str, name: (usize, usize)) -> Option<(usize, usize)> {
+    let (mut line, mut col) = name;
+    let rest = text.get(line_start(text, line)?..)?;
+    let mut colon = false;
+    for c in rest.chars().skip(col.saturating_sub(1)) {
+        match c {
+            '\n' => {
+                line += 1;
+                col = 1;
+                continue;
+            }
+            ':' if !colon => colon = true,
+            c if colon && !c.is_whitespace() => return Some((line, col)),
+            _ => {}
+        }
+        col += 1;
+    }
+    None
+}
+
+/// How [`tuple_words`] ends its message for a tuple whose `)` is missing (reported at
+/// the tuple's start).
+const NOT_CLOSED: &str = " (it opens here)";
 
 /// A decimal number where a whole number belongs, at `(line, col)` of `text` (its `.`,
 /// or its start): said of its field, or of its place in a tuple.
@@ -699,8 +727,31 @@ fn tuple_words(text: &str, line: usize, col: usize, message: &str) -> Option<Str
             )
             .filter(|c| !c.is_whitespace())
             .last();
-        return (before == Some(','))
-            .then(|| format!("`{name}` has more than {index} values (found `{element}`)"));
+        if before != Some(',') {
+            return None;
+        }
+        // `name:` where a value belongs: the next field, so the tuple's `)` is missing.
+        let after: String = line_start(text, line)
+            .and_then(|s| text.get(s..))
+            .unwrap_or("")
+            .chars()
+            .skip(col.saturating_sub(1))
+            .skip_while(|c| c.is_whitespace() || *c == ',')
+            .take_while(|c| !matches!(c, '(' | ')' | ',' | '"'))
+            .take(64)
+            .collect();
+        if let Some((next, _)) = after.split_once(':')
+            && let next = next.trim()
+            && !next.is_empty()
+            && next.chars().all(|c| c.is_alphanumeric() || c == '_')
+        {
+            return Some(format!(
+                "`{name}` is not closed: a `)` is missing before `{next}`{NOT_CLOSED}"
+            ));
+        }
+        return Some(format!(
+            "`{name}` has more than {index} values (found `{element}`)"
+        ));
     }
     let what = cov_path::expected_value(message, &element)?;
     Some(if element.is_empty() {
@@ -843,10 +894,29 @@ impl SceneFile {
                     "found `{found}` among `{owner}`'s fields: is the `)` that closes the `{owner}` before it missing?"
                 );
             } else if let Some(words) = tuple_words(text, line, col, &message) {
+                // The tuple's count at its start; a value in it at its own start (ron
+                // stops after a sign).
+                let start = cov_path::number_start(text, line, col);
+                at = if message.starts_with("Expected a tuple of size") {
+                    value_at()
+                } else if words.ends_with(NOT_CLOSED)
+                    && let Some(((_, name_at, _), _, _)) = cov_path::element_at(text, line, start)
+                {
+                    after_colon(text, name_at).unwrap_or((line, col))
+                } else {
+                    (line, start)
+                };
                 message = words;
+            } else if let Some(tail) = message.strip_prefix("Unexpected missing field named `")
+                && let Some((name, rest)) = tail.split_once('`')
+            {
+                let owner = rest.strip_prefix(" in ").map(|o| format!(" from {o}")).unwrap_or_default();
+                message = format!("`{name}` is missing{owner}: it has no default");
             } else if message.starts_with("Expected") && !message.contains(" found ") {
                 // A syntax error: say what stands where something else was expected.
-                message = format!("{message}, found {}", found_at(text, line, col));
+                let (found, c) = found_at(text, line, col);
+                message = format!("{message}, found {found}");
+                at = (line, c);
             }
             SceneError {
                 file: file.to_string(),

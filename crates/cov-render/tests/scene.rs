@@ -509,6 +509,25 @@ fn a_wrong_value_is_pointed_at_where_it_starts() {
             unclosed,
             "6:9: found `Sphere` among `Sphere`'s fields: is the `)` that closes the `Sphere` before it missing?",
         ),
+        // A tuple of too few values, at its start; a tuple not closed before the next
+        // field.
+        (
+            "(position: (0.0, 1.0, 3.0)",
+            "(position: (0.0, 1.0)",
+            "2:24: `position` = (0.0, 1.0): expected 3 values, found 2",
+        ),
+        (
+            "(position: (0.0, 1.0, 3.0)",
+            "(position: (0.0, 1.0, 3.0,",
+            "2:24: `position` is not closed: a `)` is missing before `look_at` (it opens here)",
+        ),
+        // A required field left out, and a syntax error at the token, not the blank.
+        (
+            "fov: FOV, ",
+            "",
+            "2:86: `fov` is missing from `Camera`: it has no default",
+        ),
+        ("fov: FOV", "fov   = 40.0", "2:73: Expected colon, found `=`"),
         // A field written twice: said in the scene's words, at the second one.
         (
             "FOV",
