@@ -521,30 +521,24 @@ type Failure = (u32, String);
 
 /// The camera of a description.
 fn camera(c: &CameraDesc) -> Result<Camera, Failure> {
-    let position = v(c.position.value);
-    if !position.is_finite() || position.abs().max_element() > MAX_COORD {
-        return Err((
-            c.position.ordinal,
+    // A point of the camera's, `field`, within the scene's extent.
+    let point = |p: &At<V3>, field: &str| -> Result<DVec3, Failure> {
+        let x = v(p.value);
+        if x.is_finite() && x.abs().max_element() <= MAX_COORD {
+            return Ok(x);
+        }
+        Err((
+            p.ordinal,
             format!(
-                "`position` must lie within ±{MAX_COORD:e} m of the origin, as every point of the scene does, got ({}, {}, {})",
-                cov_core::num(position.x),
-                cov_core::num(position.y),
-                cov_core::num(position.z)
+                "`{field}` must lie within ±{MAX_COORD:e} m of the origin, as every point of the scene does, got ({}, {}, {})",
+                cov_core::num(x.x),
+                cov_core::num(x.y),
+                cov_core::num(x.z)
             ),
-        ));
-    }
-    let aim = v(c.look_at.value);
-    if !aim.is_finite() || aim.abs().max_element() > MAX_COORD {
-        return Err((
-            c.look_at.ordinal,
-            format!(
-                "`look_at` must lie within ±{MAX_COORD:e} m of the origin, as every point of the scene does, got ({}, {}, {})",
-                cov_core::num(aim.x),
-                cov_core::num(aim.y),
-                cov_core::num(aim.z)
-            ),
-        ));
-    }
+        ))
+    };
+    let position = point(&c.position, "position")?;
+    let aim = point(&c.look_at, "look_at")?;
     let look = aim - position;
     if look.length() <= 0.0 {
         return Err((c.look_at.ordinal, "the camera looks at its own position".into()));
