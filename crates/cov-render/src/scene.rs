@@ -364,7 +364,7 @@ pub enum MaterialDesc {
         /// Reflectance per channel, ≤ 1.
         albedo: At<Rgb>,
         /// Exponent, 0 to 1e12 (`world::MIN_LOBE_WIDTH`).
-        exponent: NonNegative,
+        exponent: At<NonNegative>,
         /// A texture from `textures` that multiplies the albedo.
         #[serde(default)]
         texture: Option<At<String>>,
@@ -374,7 +374,7 @@ pub enum MaterialDesc {
         /// Reflectance per channel, ≤ 1.
         albedo: At<Rgb>,
         /// Roughness, at least 1e-6 (`world::MIN_LOBE_WIDTH`).
-        alpha: Positive,
+        alpha: At<Positive>,
         /// A texture from `textures` that multiplies the albedo.
         #[serde(default)]
         texture: Option<At<String>>,
@@ -401,9 +401,9 @@ pub enum TextureDesc {
         /// Squares along `u` and `v`.
         checks: (u32, u32),
         /// The two colours (reflectances).
-        a: Rgb,
+        a: At<Rgb>,
         /// The second colour.
-        b: Rgb,
+        b: At<Rgb>,
         /// Texels per side it is rasterised on (default 1024).
         #[serde(default)]
         size: Option<u32>,
@@ -419,9 +419,9 @@ pub enum TextureDesc {
         #[serde(default)]
         duty: Option<Positive>,
         /// The background colour.
-        a: Rgb,
+        a: At<Rgb>,
         /// The stripes' colour.
-        b: Rgb,
+        b: At<Rgb>,
         /// Texels per side (default 1024).
         #[serde(default)]
         size: Option<u32>,
@@ -434,9 +434,9 @@ pub enum TextureDesc {
         /// Lattice cells per side.
         cells: u32,
         /// The colour at 0.
-        a: Rgb,
+        a: At<Rgb>,
         /// The colour at 1.
-        b: Rgb,
+        b: At<Rgb>,
         /// Seed of the lattice (default 0).
         #[serde(default)]
         seed: Option<u64>,

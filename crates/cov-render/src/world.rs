@@ -702,20 +702,20 @@ fn rotation_rate(w: &At<V3>, field: &str) -> Result<DVec3, Failure> {
     ))
 }
 
-/// A colour of the texture `name` (its description at `at`): a reflectance, at most 1 per
-/// channel.
-fn reflectance(c: Rgb, name: &At<String>, at: u32) -> Result<DVec3, Failure> {
-    let c = DVec3::from_array(c.0);
-    if c.max_element() > 1.0 {
+/// The colour `field` of the texture `name`: a reflectance, at most 1 per channel (`Err`
+/// at the colour).
+fn reflectance(c: &At<Rgb>, name: &At<String>, field: &str) -> Result<DVec3, Failure> {
+    let v = DVec3::from_array(c.value.0);
+    if v.max_element() > 1.0 {
         return Err((
-            at,
+            c.ordinal,
             format!(
-                "texture `{}`: a colour above 1 reflects more than it receives",
+                "texture `{}`: colour `{field}` above 1 reflects more than it receives",
                 crate::echo(&name.value)
             ),
         ));
     }
-    Ok(c)
+    Ok(v)
 }
 
 /// Largest side of a generated texture, by default (texels).
@@ -814,8 +814,8 @@ fn textures(desc: &SceneFile, dir: &Path) -> Result<(Vec<TextureMap>, Vec<String
             } => (
                 TextureMap::checker(
                     *checks,
-                    reflectance(*a, name, t.ordinal)?,
-                    reflectance(*b, name, t.ordinal)?,
+                    reflectance(a, name, "a")?,
+                    reflectance(b, name, "b")?,
                     size(sz),
                     rep(repeat),
                 ),
@@ -832,8 +832,8 @@ fn textures(desc: &SceneFile, dir: &Path) -> Result<(Vec<TextureMap>, Vec<String
                 TextureMap::stripes(
                     *count,
                     duty.map_or(0.5, |d| d.0),
-                    reflectance(*a, name, t.ordinal)?,
-                    reflectance(*b, name, t.ordinal)?,
+                    reflectance(a, name, "a")?,
+                    reflectance(b, name, "b")?,
                     size(sz),
                     rep(repeat),
                 ),
@@ -850,8 +850,8 @@ fn textures(desc: &SceneFile, dir: &Path) -> Result<(Vec<TextureMap>, Vec<String
                 TextureMap::noise(
                     *cells,
                     seed.unwrap_or(0),
-                    reflectance(*a, name, t.ordinal)?,
-                    reflectance(*b, name, t.ordinal)?,
+                    reflectance(a, name, "a")?,
+                    reflectance(b, name, "b")?,
                     size(sz),
                     rep(repeat),
                 ),
@@ -893,7 +893,7 @@ fn materials(desc: &SceneFile, textures: &Names<'_>) -> Result<Materials, Failur
             } => (
                 Material::Phong {
                     albedo: DVec3::from_array(albedo.value.0),
-                    exponent: exponent.0,
+                    exponent: exponent.value.0,
                 },
                 texture,
             ),
@@ -904,7 +904,7 @@ fn materials(desc: &SceneFile, textures: &Names<'_>) -> Result<Materials, Failur
             } => (
                 Material::Ggx {
                     albedo: DVec3::from_array(albedo.value.0),
-                    alpha: alpha.0,
+                    alpha: alpha.value.0,
                 },
                 texture,
             ),
@@ -924,20 +924,27 @@ fn materials(desc: &SceneFile, textures: &Names<'_>) -> Result<Materials, Failur
                 ),
             ));
         }
-        let narrow = match mat {
-            Material::Ggx { alpha, .. } if alpha < MIN_LOBE_WIDTH => Some(format!(
-                "alpha {} is below {MIN_LOBE_WIDTH:e}",
-                cov_core::num(alpha)
+        // A lobe narrower than f64 resolves, at the parameter that makes it so.
+        let narrow = match m {
+            MaterialDesc::Ggx { alpha, .. } if alpha.value.0 < MIN_LOBE_WIDTH => Some((
+                alpha.ordinal,
+                format!(
+                    "`alpha` = {} is below {MIN_LOBE_WIDTH:e}",
+                    cov_core::num(alpha.value.0)
+                ),
             )),
-            Material::Phong { exponent, .. } if exponent > MAX_PHONG_EXPONENT => Some(format!(
-                "exponent {} is above {MAX_PHONG_EXPONENT:e}",
-                cov_core::num(exponent)
+            MaterialDesc::Phong { exponent, .. } if exponent.value.0 > MAX_PHONG_EXPONENT => Some((
+                exponent.ordinal,
+                format!(
+                    "`exponent` = {} is above {MAX_PHONG_EXPONENT:e}",
+                    cov_core::num(exponent.value.0)
+                ),
             )),
             _ => None,
         };
-        if let Some(what) = narrow {
+        if let Some((ordinal, what)) = narrow {
             return Err((
-                name.ordinal,
+                ordinal,
                 format!(
                     "material `{}`: {what}, a lobe narrower than f64 resolves directions (its reflections would vanish)",
                     crate::echo(&name.value)

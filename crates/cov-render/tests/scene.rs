@@ -96,14 +96,14 @@ fn checks_after_parsing_point_at_the_value() {
         // Lobes narrower than f64 resolves directions lost their reflections unsaid.
         (
             &[("MAT", r#""glass": Ggx(albedo: (0.5, 0.5, 0.5), alpha: 1e-10)"#)],
-            "3:57: material `glass`: alpha 1e-10 is below 1e-6, a lobe narrower than f64 resolves",
+            "3:102: material `glass`: `alpha` = 1e-10 is below 1e-6, a lobe narrower than f64 resolves",
         ),
         (
             &[(
                 "MAT",
                 r#""glass": Phong(albedo: (0.5, 0.5, 0.5), exponent: 1e20)"#,
             )],
-            "3:57: material `glass`: exponent 1e20 is above 1e12, a lobe narrower",
+            "3:107: material `glass`: `exponent` = 1e20 is above 1e12, a lobe narrower",
         ),
         (&[("LIGHTS", "[]")], "4:13: the scene has no light"),
         (
@@ -540,10 +540,11 @@ fn a_wrong_value_is_pointed_at_where_it_starts() {
     }
 }
 
-/// A decimal below 1 where a whole number belongs is not read as 0; a file of comments
-/// alone holds no scene.
+/// Values are said as written, at themselves: a decimal below 1 where a whole number
+/// belongs is not read as 0, a texture's colour above 1 is pointed at, a number too large
+/// for a float is not "inf"; a file of comments alone holds no scene.
 #[test]
-fn decimals_and_empty_files_are_said_as_written() {
+fn values_are_said_as_written() {
     let e = error(&scene(&[("width: 8", "width: 0.5")]));
     assert!(
         e.starts_with("2:85: `width` = 0.5: expected a whole number, found a decimal number"),
@@ -552,6 +553,16 @@ fn decimals_and_empty_files_are_said_as_written() {
     // A decimal the parser refuses as a number of its own type is said as before.
     let e = error(&scene(&[("FOV", "0.5, width: 8.5")]).replace(", width: 8, height", ", height"));
     assert!(e.contains("`width` = 8.5: expected a whole number"), "{e}");
+    // A texture's colour above 1, at the colour.
+    let t = BASE.replace(
+        "    materials:",
+        "    textures: { \"t\": Checker(checks: (2, 2), a: (1.0, 1.0, 1.0), b: (0.0, 1.5, 0.0)) },\n    materials:",
+    );
+    let e = error(&scene_from(&t));
+    assert!(
+        e.starts_with("3:69: texture `t`: colour `b` above 1 reflects more than it receives"),
+        "{e}"
+    );
     // A number too large for a float is said as written, not as infinity.
     let e = error(&scene(&[("FOV", "1e400")]));
     assert!(

@@ -49,7 +49,7 @@ fn texture_errors_are_positioned_and_one_line() {
         ),
         (
             base.replace("a: (0.8, 0.8, 0.8)", "a: (1.8, 0.8, 0.8)"),
-            "s.ron:3:30: texture `board`: a colour above 1 reflects more than it receives",
+            "s.ron:3:57: texture `board`: colour `a` above 1 reflects more than it receives",
         ),
         (
             base.replace("size: 512", "size: 100000"),
