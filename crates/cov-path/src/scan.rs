@@ -206,14 +206,20 @@ pub fn field_at(text: &str, line: usize, col: usize) -> Option<(String, (usize, 
 }
 
 /// Where the value of [`field_at`]'s field starts (line, column, 1-based): its first
-/// character after the colon that is not blank or a comment.
+/// character after the colon that is not blank or a comment. A position on an element of a
+/// tuple or a list, which has no `name:` of its own ([`element_at`]), gives where the
+/// tuple or list starts: its opening bracket.
 pub fn value_position(text: &str, line: usize, col: usize) -> Option<(usize, usize)> {
     let text = text.strip_prefix('\u{feff}').unwrap_or(text);
     let chars = code_of(&text.chars().collect::<Vec<char>>());
     let pos = char_positions(&chars);
-    let (_, _, colon) = field_span(&chars, &pos, line, col)?;
-    let v = (colon + 1..chars.len()).find(|&v| !chars[v].is_whitespace())?;
-    Some(pos[v])
+    if let Some((_, _, colon)) = field_span(&chars, &pos, line, col) {
+        let v = (colon + 1..chars.len()).find(|&v| !chars[v].is_whitespace())?;
+        return Some(pos[v]);
+    }
+    let at = pos.iter().position(|&p| p >= (line, col)).unwrap_or(chars.len());
+    let (open, _) = open_bracket(&chars, at)?;
+    Some(pos[open])
 }
 
 /// [`field_at`]'s field in `chars` (a [`code_of`], `pos` its positions): the indices of
@@ -333,25 +339,32 @@ pub fn element_at(text: &str, line: usize, col: usize) -> Option<(Field, usize, 
     let chars = code_of(&written);
     let pos = char_positions(&chars);
     let at = pos.iter().position(|&p| p >= (line, col)).unwrap_or(chars.len());
+    let (open, index) = open_bracket(&chars, at)?;
+    let (l, c) = pos[open];
+    let field = field_at(text, l, c)?;
+    let element = value_from(&written, &chars, at);
+    Some((field, index, element))
+}
+
+/// The tuple's or list's opening bracket before index `at` of `chars` (a [`code_of`]) at
+/// its own level, and the index of the element `at` is in (commas between them); `None`
+/// inside a map or outside any bracket.
+fn open_bracket(chars: &[char], at: usize) -> Option<(usize, usize)> {
     let (mut depth, mut index, mut i) = (0usize, 0usize, at);
-    let open = loop {
+    loop {
         if i == 0 {
             return None;
         }
         i -= 1;
         match chars[i] {
             ')' | ']' | '}' => depth += 1,
-            '(' | '[' if depth == 0 => break i,
+            '(' | '[' if depth == 0 => return Some((i, index)),
             '{' if depth == 0 => return None,
             '(' | '[' | '{' => depth -= 1,
             ',' if depth == 0 => index += 1,
             _ => {}
         }
-    };
-    let (l, c) = pos[open];
-    let field = field_at(text, l, c)?;
-    let element = value_from(&written, &chars, at);
-    Some((field, index, element))
+    }
 }
 
 /// The first whitespace character other than an ASCII space, tab or line break (a

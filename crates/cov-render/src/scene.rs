@@ -631,26 +631,15 @@ fn found_at(text: &str, line: usize, col: usize) -> (String, usize) {
     (format!("`{token}`"), at)
 }
 
-/// Where the value of the field whose name is at `name` (line, column) starts: the first
-/// character after its colon that is not blank.
-fn after_colon(text: &str, name: (usize, usize)) -> Option<(usize, usize)> {
-    let (mut line, mut col) = name;
-    let rest = text.get(line_start(text, line)?..)?;
-    let mut colon = false;
-    for c in rest.chars().skip(col.saturating_sub(1)) {
-        match c {
-            '\n' => {
-                line += 1;
-                col = 1;
-                continue;
-            }
-            ':' if !colon => colon = true,
-            c if colon && !c.is_whitespace() => return Some((line, col)),
-            _ => {}
-        }
-        col += 1;
-    }
-    None
+/// ron's message `message` of the form `PREFIX `name` in `Type`…` (a field it did not
+/// expect, one given twice, one left out): the field's name and the type's, if said.
+fn named<'m>(message: &'m str, prefix: &str) -> Option<(&'m str, Option<&'m str>)> {
+    let (name, rest) = message
+        .strip_prefix(prefix)?
+        .strip_prefix(" `")?
+        .split_once('`')?;
+    let owner = rest.strip_prefix(" in `").and_then(|o| o.split('`').next());
+    Some((name, owner))
 }
 
 /// How [`tuple_words`] ends its message for a tuple whose `)` is missing (reported at
@@ -825,15 +814,10 @@ impl SceneFile {
             {
                 message = words;
                 at = (line, cov_path::number_start(text, line, col));
-            } else if let Some(tail) = message.strip_prefix("Unexpected duplicate field named `")
-                && let Some((name, rest)) = tail.split_once('`')
-            {
+            } else if let Some((name, owner)) = named(&message, "Unexpected duplicate field named") {
                 // ron's `in `Camera``: the type's name, which the scene writes in lower case
                 // only as a field (`camera: (…)`); said as the type.
-                let owner = rest
-                    .strip_prefix(" in ")
-                    .map(|o| format!(" in {o}"))
-                    .unwrap_or_default();
+                let owner = owner.map(|o| format!(" in `{o}`")).unwrap_or_default();
                 message = format!("`{name}` is given twice{owner}: remove one");
             } else if let ron::Error::Message(m) = &e.code
                 && let Some((_, _, value)) = field()
@@ -883,10 +867,8 @@ impl SceneFile {
                 };
                 message = format!("`{name}` = {}: expected {what}", cov_core::echo(&value));
                 at = value_at();
-            } else if let Some(tail) = message.strip_prefix("Unexpected field named `")
-                && let Some((found, rest)) = tail.split_once('`')
+            } else if let Some((found, Some(owner))) = named(&message, "Unexpected field named")
                 && found.starts_with(|c: char| c.is_ascii_uppercase())
-                && let Some(owner) = rest.strip_prefix(" in `").and_then(|o| o.split('`').next())
             {
                 // Every field is in lower case: a name in capitals (`Sphere`) is the next
                 // entry of a list, read as a field because a `)` is missing before it.
@@ -896,21 +878,14 @@ impl SceneFile {
             } else if let Some(words) = tuple_words(text, line, col, &message) {
                 // The tuple's count at its start; a value in it at its own start (ron
                 // stops after a sign).
-                let start = cov_path::number_start(text, line, col);
-                at = if message.starts_with("Expected a tuple of size") {
+                at = if message.starts_with("Expected a tuple of size") || words.ends_with(NOT_CLOSED) {
                     value_at()
-                } else if words.ends_with(NOT_CLOSED)
-                    && let Some(((_, name_at, _), _, _)) = cov_path::element_at(text, line, start)
-                {
-                    after_colon(text, name_at).unwrap_or((line, col))
                 } else {
-                    (line, start)
+                    (line, cov_path::number_start(text, line, col))
                 };
                 message = words;
-            } else if let Some(tail) = message.strip_prefix("Unexpected missing field named `")
-                && let Some((name, rest)) = tail.split_once('`')
-            {
-                let owner = rest.strip_prefix(" in ").map(|o| format!(" from {o}")).unwrap_or_default();
+            } else if let Some((name, owner)) = named(&message, "Unexpected missing field named") {
+                let owner = owner.map(|o| format!(" from `{o}`")).unwrap_or_default();
                 message = format!("`{name}` is missing{owner}: it has no default");
             } else if message.starts_with("Expected") && !message.contains(" found ") {
                 // A syntax error: say what stands where something else was expected.

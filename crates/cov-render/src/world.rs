@@ -1010,10 +1010,7 @@ fn lights(desc: &SceneFile, prims: &mut Vec<Prim>) -> Result<Vec<Light>, Failure
                 let (c0, eu, ev) = (v(corner.value), v(edge_u.value), v(*edge_v));
                 let cr = eu.cross(ev);
                 if cr.length() <= 0.0 {
-                    return Err((
-                        edge_u.ordinal,
-                        "a Rect light's `edge_u` and `edge_v` span no area (one is zero, or they are parallel)".into(),
-                    ));
+                    return Err((edge_u.ordinal, no_area("a Rect light's")));
                 }
                 lights.push(Light::Rect {
                     corner: c0,
@@ -1129,6 +1126,12 @@ fn at_least(least: f64) -> String {
         cov_core::approx(least),
         crate::geometry::MIN_SIZE
     )
+}
+
+/// What is said of a parallelogram (`whose`: "a Quad's", "a Rect light's") whose edges
+/// span no area.
+fn no_area(whose: &str) -> String {
+    format!("{whose} `edge_u` and `edge_v` span no area (one is zero, or they are parallel)")
 }
 
 /// `Err` at `ordinal` if a primitive of `prims[from..]` (a `what`: sphere, quad, mesh,
@@ -1249,11 +1252,7 @@ fn shapes(
             } => {
                 let (eu, ev) = (v(edge_u.value), v(*edge_v));
                 if eu.cross(ev).length() <= 0.0 {
-                    return Err((
-                        edge_u.ordinal,
-                        "a Quad's `edge_u` and `edge_v` span no area (one is zero, or they are parallel)"
-                            .into(),
-                    ));
+                    return Err((edge_u.ordinal, no_area("a Quad's")));
                 }
                 for (tri, uv) in quad_triangles(v(corner.value), eu, ev).into_iter().zip(QUAD_UV) {
                     push(Shape::triangle(tri, None, Some(uv)));
