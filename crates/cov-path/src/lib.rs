@@ -41,5 +41,8 @@ pub use path::{
     whole_number_at,
 };
 pub use registry::{Entry, Registry};
-pub use scan::{blank_or_comment, element_at, field_at, odd_space_before, value_position};
+pub use scan::{
+    blank_or_comment, element_at, enclosing_field, field_at, odd_space_before, token_error, value_position,
+    written_after_close,
+};
 pub use source::Source;

@@ -59,6 +59,9 @@ fn explain(
     if let Some(((l, c), words)) = crate::scan::odd_space_before(text, line, col) {
         return (l, c, words);
     }
+    if let Some(((l, c), words)) = crate::scan::token_error(text, line, col, &msg) {
+        return (l, c, words);
+    }
     // `0x10` where a decimal number belongs: ron reads the `0` and stops at the `x`.
     if let Some((name, (l, c), value)) = crate::scan::field_at(text, line, col)
         && let Some(words) = not_decimal(&value)

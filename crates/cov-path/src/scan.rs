@@ -191,7 +191,8 @@ pub fn blank_or_comment(text: &str) -> bool {
 /// col)` (1-based, as ron reports it) being in that value or just before it, where ron
 /// reports a value of the wrong type, or at the closing parenthesis of a tuple it
 /// refused: the nearest `name:` before the value at its own bracket level, the name's
-/// position, and the value as written (at most 40 characters). An optional value written
+/// position, and the value as written (cut after 40 characters where a word or a number
+/// ends). An optional value written
 /// `Some(…)` is the field's value whole: a position inside it is the field's. `None`
 /// when no `name:` stands between the position and the bracket that opens its level (an
 /// entry of a list). A leading byte-order mark is not counted, as ron does not count it.
@@ -287,8 +288,8 @@ fn word_before(chars: &[char], i: usize) -> (usize, usize) {
 
 /// The value written from `v` in `written` (`chars`: its [`code_of`], comments blanked
 /// and strings' contents replaced), blanks before it skipped, to the comma, line end or
-/// closing bracket that ends it at its own level: at most 40 characters, comments and
-/// runs of blanks read as one space, trailing blanks trimmed.
+/// closing bracket that ends it at its own level: cut after 40 characters where a word or
+/// a number ends, comments and runs of blanks read as one space, trailing blanks trimmed.
 fn value_from(written: &[char], chars: &[char], mut v: usize) -> String {
     while v < chars.len() && chars[v].is_whitespace() {
         v += 1;
@@ -316,7 +317,9 @@ fn value_from(written: &[char], chars: &[char], mut v: usize) -> String {
         } else {
             out.push(*c);
         }
-        if out.chars().count() >= 40 {
+        // Past 40 characters, at the first blank or bracket: a number of 5,000 digits is
+        // read whole, so that what it is (too large for a float) can be told.
+        if out.chars().count() >= 40 && !code.is_alphanumeric() && !matches!(code, '.' | '_' | '-' | '+') {
             break;
         }
     }
@@ -378,20 +381,187 @@ pub fn odd_space_before(text: &str, line: usize, col: usize) -> Option<((usize, 
     // Up to the error and the run of whitespace that follows it (ron may stop just before
     // the odd character).
     let mut end = pos.iter().position(|&p| p > (line, col)).unwrap_or(chars.len());
-    while end < chars.len() && chars[end].is_whitespace() {
+    while end < chars.len() && (chars[end].is_whitespace() || invisible(chars[end])) {
         end += 1;
     }
     let (i, c) = chars[..end]
         .iter()
         .enumerate()
-        .find(|(_, c)| c.is_whitespace() && !matches!(c, ' ' | '\t' | '\n' | '\r'))?;
+        .find(|(_, c)| (c.is_whitespace() || invisible(**c)) && !matches!(c, ' ' | '\t' | '\n' | '\r'))?;
+    let code = u32::from(*c);
+    let what = if invisible(*c) {
+        format!("an invisible U+{code:04X} character")
+    } else {
+        format!("a U+{code:04X} space character")
+    };
     Some((
         pos[i],
         format!(
-            "a U+{:04X} space character here: a file reads only plain spaces, tabs and line breaks between values (it often comes from pasting text)",
-            u32::from(*c)
+            "{what} here: a file reads only plain spaces, tabs and line breaks between values (it often comes from pasting text)"
         ),
     ))
+}
+
+/// Whether `c` is a character of no width that is not whitespace to Unicode (a zero-width
+/// space U+200B, a zero-width joiner or non-joiner, a word joiner U+2060, a byte-order
+/// mark inside the text): invisible where it is pasted, and no blank to ron.
+fn invisible(c: char) -> bool {
+    matches!(c, '\u{200B}'..='\u{200D}' | '\u{2060}' | '\u{FEFF}')
+}
+
+/// The string that ron's error at `(line, col)` of `text` follows, if it runs over a line
+/// break: a name or a file path never does, so its closing `"` is missing and the string
+/// ran on to the next `"`, where ron then stopped. The string's opening quote and the line
+/// it ends on (1-based).
+fn string_across_lines(text: &str, line: usize, col: usize) -> Option<((usize, usize), usize)> {
+    let text = text.strip_prefix('\u{feff}').unwrap_or(text);
+    let chars: Vec<char> = text.chars().collect();
+    let pos = char_positions(&chars);
+    let end = pos.iter().position(|&p| p >= (line, col)).unwrap_or(chars.len());
+    let mut last = None;
+    let mut i = 0;
+    while i < end {
+        if let Some(next) = skip_comment(&chars, i) {
+            i = next;
+        } else if chars[i] == '"' {
+            let next = skip_string(&chars, i).min(chars.len());
+            last = Some((i, next));
+            i = next;
+        } else {
+            i += 1;
+        }
+    }
+    let (open, next) = last?;
+    let close = next.saturating_sub(1).max(open);
+    chars[open..close]
+        .contains(&'\n')
+        .then(|| (pos[open], pos[close.min(chars.len() - 1)].0))
+}
+
+/// The first block comment of `text` that is not closed (`/*` without its `*/`; comments
+/// nest), at its `/*`: ron reports it at the end of the file.
+fn unclosed_comment(text: &str) -> Option<(usize, usize)> {
+    let text = text.strip_prefix('\u{feff}').unwrap_or(text);
+    let chars: Vec<char> = text.chars().collect();
+    let pos = char_positions(&chars);
+    let mut i = 0;
+    while i < chars.len() {
+        if let Some(next) = skip_comment(&chars, i) {
+            let closed = chars[i + 1] == '/' || (next >= i + 4 && chars[next - 2..next] == ['*', '/']);
+            if !closed {
+                return Some(pos[i]);
+            }
+            i = next;
+        } else if chars[i] == '"' {
+            i = skip_string(&chars, i);
+        } else {
+            i += 1;
+        }
+    }
+    None
+}
+
+/// The first backslash in the string at or after `(line, col)` of `text` that starts no
+/// escape ron reads (`\\`, `\"`, `\'`, `\n`, `\r`, `\t`, `\0`, `\x…`, `\u{…}`), where
+/// ron reports it at the string's start: its position and the two characters.
+fn bad_escape(text: &str, line: usize, col: usize) -> Option<((usize, usize), String)> {
+    let text = text.strip_prefix('\u{feff}').unwrap_or(text);
+    let chars: Vec<char> = text.chars().collect();
+    let pos = char_positions(&chars);
+    let start = pos.iter().position(|&p| p >= (line, col)).unwrap_or(chars.len());
+    // The string holding the position, or the next one.
+    let open = (0..=start.min(chars.len().saturating_sub(1)))
+        .rev()
+        .find(|&i| chars[i] == '"')
+        .filter(|&i| skip_string(&chars, i) > start)
+        .or_else(|| (start..chars.len()).find(|&i| chars[i] == '"'))?;
+    let end = skip_string(&chars, open).min(chars.len());
+    let mut i = open + 1;
+    while i + 1 < end {
+        if chars[i] == '\\' {
+            let c = chars[i + 1];
+            if !matches!(c, '\'' | '"' | '\\' | 'n' | 'r' | 't' | '0' | 'x' | 'u') {
+                return Some((pos[i], format!("\\{c}")));
+            }
+            i += 2;
+        } else {
+            i += 1;
+        }
+    }
+    None
+}
+
+/// Errors of the text's tokens rather than its structure, which ron places where it
+/// noticed them, not where they are: a string whose closing `"` is missing (it runs on
+/// over line breaks to the next `"`), a backslash that starts no escape (ron points at
+/// the string's start), a block comment not closed (ron points at the end of the file).
+/// `message` is ron's, at `(line, col)`; the place and the message, or `None`.
+pub fn token_error(text: &str, line: usize, col: usize, message: &str) -> Option<((usize, usize), String)> {
+    if message.starts_with("Unclosed block comment") {
+        let at = unclosed_comment(text)?;
+        return Some((at, "this block comment is not closed: its `*/` is missing".into()));
+    }
+    if message.starts_with("Unknown escape") || message.starts_with("Invalid escape") {
+        let (at, escape) = bad_escape(text, line, col)?;
+        return Some((
+            at,
+            format!(
+                "`{}` is no escape a string knows: write a backslash as `\\\\` (in a file path, `/` does)",
+                cov_core::echo(&escape)
+            ),
+        ));
+    }
+    let (at, end) = string_across_lines(text, line, col)?;
+    Some((
+        at,
+        format!("this string runs on to line {end}: is its closing `\"` missing?"),
+    ))
+}
+
+/// The field whose value is the parenthesised struct or tuple that encloses `(line, col)`
+/// of `text`: its name and where the name is written. `None` outside one, or for an
+/// entry of a list.
+pub fn enclosing_field(text: &str, line: usize, col: usize) -> Option<(String, (usize, usize))> {
+    let text = text.strip_prefix('\u{feff}').unwrap_or(text);
+    let chars = code_of(&text.chars().collect::<Vec<char>>());
+    let pos = char_positions(&chars);
+    let at = pos.iter().position(|&p| p >= (line, col)).unwrap_or(chars.len());
+    let (open, _) = open_bracket(&chars, at)?;
+    let (l, c) = pos[open];
+    let (name, place, _) = field_at(text, l, c)?;
+    Some((name, place))
+}
+
+/// Whether the field `name` is written after the `)` at `(line, col)` of `text`, at that
+/// parenthesis's own level (before the bracket that closes the level around it): a field
+/// written after a struct's closing parenthesis was meant to be inside it. `false` if no
+/// `)` stands there.
+pub fn written_after_close(text: &str, line: usize, col: usize, name: &str) -> bool {
+    let text = text.strip_prefix('\u{feff}').unwrap_or(text);
+    let chars = code_of(&text.chars().collect::<Vec<char>>());
+    let pos = char_positions(&chars);
+    let Some(at) = pos.iter().position(|&p| p >= (line, col)) else {
+        return false;
+    };
+    if chars[at] != ')' {
+        return false;
+    }
+    let mut depth = 0usize;
+    for i in at + 1..chars.len() {
+        match chars[i] {
+            '(' | '[' | '{' => depth += 1,
+            ')' | ']' | '}' if depth == 0 => return false,
+            ')' | ']' | '}' => depth -= 1,
+            ':' if depth == 0 => {
+                let (a, b) = word_before(&chars, i);
+                if chars[a..b].iter().copied().eq(name.chars()) {
+                    return true;
+                }
+            }
+            _ => {}
+        }
+    }
+    false
 }
 
 /// Every element of every operator list, in the order of the text.
@@ -618,5 +788,44 @@ mod tests {
         assert_eq!(bare, vec![true, false, false, true, false]);
         assert_eq!(top, vec![true, true, false, false, true]);
         assert_eq!(operator_positions(t).len(), 3);
+    }
+
+    /// Token mistakes are placed where they are written: the opening quote of a string
+    /// that runs over a line break, the backslash of an unknown escape, the `/*` of a
+    /// comment never closed; escapes ron reads and closed comments are no mistakes.
+    #[test]
+    fn token_mistakes_are_placed() {
+        let text = "Path(\n  source: \"a,\n  b\": 1,\n)";
+        let (at, words) = token_error(text, 3, 5, "Expected colon").expect("found");
+        assert_eq!(at, (2, 11));
+        assert!(words.contains("runs on to line 3"), "{words}");
+        // A string closed on its own line is no mistake, however the text goes on.
+        assert!(token_error("X(a: \"ok \\\" \\n\", b: 1)", 1, 20, "Expected comma").is_none());
+        let (at, words) =
+            token_error("X(a: \"c:\\files\\x.png\")", 1, 6, "Unknown escape character").expect("found");
+        assert_eq!(at, (1, 9));
+        assert!(words.starts_with("`\\f` is no escape"), "{words}");
+        let text = "/* a /* nested */ still open\nX(a: 1)";
+        assert_eq!(
+            token_error(text, 2, 8, "Unclosed block comment").map(|t| t.0),
+            Some((1, 1))
+        );
+        let text = "/* closed */ X(a: 1) /* open";
+        assert_eq!(
+            token_error(text, 1, 29, "Unclosed block comment").map(|t| t.0),
+            Some((1, 22))
+        );
+    }
+
+    /// A `)` too many, and a field of the enclosing struct read inside an unclosed one.
+    #[test]
+    fn a_parenthesis_too_many_or_missing() {
+        let text = "S(c: (a: 1), b: 2), d: 3)";
+        assert!(written_after_close(text, 1, 11, "b"));
+        assert!(!written_after_close(text, 1, 11, "d"));
+        assert!(!written_after_close(text, 1, 10, "b"));
+        let text = "S(\n  c: (a: 1,\n  b: 2)\n)";
+        assert_eq!(enclosing_field(text, 3, 3), Some(("c".to_string(), (2, 3))));
+        assert_eq!(enclosing_field("[(a: 1)]", 1, 3), None);
     }
 }

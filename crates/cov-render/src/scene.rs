@@ -394,45 +394,45 @@ pub enum TextureDesc {
         file: At<String>,
         /// Repeats over a unit of `u` and `v` (default 1, 1).
         #[serde(default)]
-        repeat: Option<Repeat>,
+        repeat: Option<At<Repeat>>,
     },
     /// A checkerboard.
     Checker {
         /// Squares along `u` and `v`.
-        checks: (u32, u32),
+        checks: At<(u32, u32)>,
         /// The two colours (reflectances).
         a: At<Rgb>,
         /// The second colour.
         b: At<Rgb>,
         /// Texels per side it is rasterised on (default 1024).
         #[serde(default)]
-        size: Option<u32>,
+        size: Option<At<u32>>,
         /// Repeats over a unit of `u` and `v` (default 1, 1).
         #[serde(default)]
-        repeat: Option<Repeat>,
+        repeat: Option<At<Repeat>>,
     },
     /// Stripes along `v` (bands running along `u`).
     Stripes {
         /// Periods over a unit of `v`.
-        count: u32,
+        count: At<u32>,
         /// Fraction of each period in colour `b`, centred in it (default 0.5).
         #[serde(default)]
-        duty: Option<Positive>,
+        duty: Option<At<Positive>>,
         /// The background colour.
         a: At<Rgb>,
         /// The stripes' colour.
         b: At<Rgb>,
         /// Texels per side (default 1024).
         #[serde(default)]
-        size: Option<u32>,
+        size: Option<At<u32>>,
         /// Repeats over a unit of `u` and `v` (default 1, 1).
         #[serde(default)]
-        repeat: Option<Repeat>,
+        repeat: Option<At<Repeat>>,
     },
     /// Smooth value noise between two colours.
     Noise {
         /// Lattice cells per side.
-        cells: u32,
+        cells: At<u32>,
         /// The colour at 0.
         a: At<Rgb>,
         /// The colour at 1.
@@ -442,10 +442,10 @@ pub enum TextureDesc {
         seed: Option<u64>,
         /// Texels per side (default 1024).
         #[serde(default)]
-        size: Option<u32>,
+        size: Option<At<u32>>,
         /// Repeats over a unit of `u` and `v` (default 1, 1).
         #[serde(default)]
-        repeat: Option<Repeat>,
+        repeat: Option<At<Repeat>>,
     },
 }
 
@@ -631,6 +631,19 @@ fn found_at(text: &str, line: usize, col: usize) -> (String, usize) {
     (format!("`{token}`"), at)
 }
 
+/// A value written from `(line, col)` of `text` (or from the number ron stopped inside)
+/// that begins as a number and is none, `0x1` or `4O.0`, where ron read the leading digits
+/// and then stopped: the field's name, the value's index in its tuple or list (`None`:
+/// the field's value itself), and the value as written.
+fn not_a_number(text: &str, line: usize, col: usize) -> Option<(String, Option<usize>, String)> {
+    let (name, index, written) = cov_path::whole_number_at(text, line, col)?;
+    let token = written.split([' ', ')', ']']).next().unwrap_or("");
+    let digits = token.trim_start_matches(['-', '+']);
+    let is_number = digits.starts_with(|c: char| c.is_ascii_digit() || c == '.');
+    (is_number && token.parse::<f64>().is_err() && token.chars().any(|c| c.is_alphabetic()))
+        .then(|| (name, index, token.to_string()))
+}
+
 /// ron's message `message` of the form `PREFIX `name` in `Type`…` (a field it did not
 /// expect, one given twice, one left out): the field's name and the type's, if said.
 fn named<'m>(message: &'m str, prefix: &str) -> Option<(&'m str, Option<&'m str>)> {
@@ -771,6 +784,13 @@ impl SceneFile {
                 };
             }
             let mut message = e.code.to_string();
+            if let Some((at, words)) = cov_path::token_error(text, line, col, &message) {
+                return SceneError {
+                    file: file.to_string(),
+                    at: Some(at),
+                    message: words,
+                };
+            }
             // Where the message points: ron's position, or the start of the value it is
             // about (ron stops after a sign, inside a number or before a string's blank).
             let mut at = (line, col);
@@ -884,9 +904,33 @@ impl SceneFile {
                     (line, cov_path::number_start(text, line, col))
                 };
                 message = words;
+            } else if let Some((found, Some(owner))) = named(&message, "Unexpected field named")
+                && let Some((outer, (l, c))) = cov_path::enclosing_field(text, line, col)
+                && line > l
+                && col <= c
+            {
+                // A field of the enclosing struct, written where it would be, read as one of
+                // this struct's because the `)` that closes this one is missing.
+                message = format!(
+                    "`{found}` is no field of `{owner}`: is the `)` that closes `{outer}` (at {l}:{c}) missing before it?"
+                );
             } else if let Some((name, owner)) = named(&message, "Unexpected missing field named") {
                 let owner = owner.map(|o| format!(" from `{o}`")).unwrap_or_default();
-                message = format!("`{name}` is missing{owner}: it has no default");
+                // A `)` too many closed the struct before the rest of its fields.
+                message = if cov_path::written_after_close(text, line, col, name) {
+                    format!("`{name}` is missing{owner}: this `)` closes it before `{name}` is read; is it one too many?")
+                } else {
+                    format!("`{name}` is missing{owner}: it has no default")
+                };
+            } else if let Some((name, index, written)) = not_a_number(text, line, col) {
+                // `0x1` or `4O.0` in a tuple: ron read the leading digits and stopped.
+                let words = cov_path::not_decimal(&written).unwrap_or("not a number");
+                let written = cov_core::echo(&written);
+                message = match index {
+                    Some(i) => format!("`{name}`: value {} = {written}: {words}", i + 1),
+                    None => format!("`{name}` = {written}: {words}"),
+                };
+                at = (line, cov_path::number_start(text, line, col));
             } else if message.starts_with("Expected") && !message.contains(" found ") {
                 // A syntax error: say what stands where something else was expected.
                 let (found, c) = found_at(text, line, col);

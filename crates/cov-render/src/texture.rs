@@ -62,10 +62,28 @@ fn lum(c: [f32; 3]) -> f64 {
     crate::material::luminance(DVec3::new(c[0] as f64, c[1] as f64, c[2] as f64))
 }
 
+/// A procedural texture's parameter out of its range: which one, by the name a scene
+/// file gives it, so that the error can be placed at it, and why.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+#[error("{why}")]
+pub struct BadParameter {
+    /// The parameter: `checks`, `count`, `duty`, `cells`, `size` or `repeat`.
+    pub name: &'static str,
+    /// What is wrong with it, in one line that names it.
+    pub why: String,
+}
+
+impl BadParameter {
+    fn new(name: &'static str, why: String) -> BadParameter {
+        BadParameter { name, why }
+    }
+}
+
 /// Checks a procedural texture's side `size`: 1 to [`MAX_TEXTURE_SIDE`] texels.
-fn checked_size(size: u32) -> Result<(), String> {
+fn checked_size(size: u32) -> Result<(), BadParameter> {
     if size == 0 || size > MAX_TEXTURE_SIDE {
-        return Err(format!("size must be 1 to {MAX_TEXTURE_SIDE} texels, got {size}"));
+        let why = format!("size must be 1 to {MAX_TEXTURE_SIDE} texels, got {size}");
+        return Err(BadParameter::new("size", why));
     }
     Ok(())
 }
@@ -73,12 +91,11 @@ fn checked_size(size: u32) -> Result<(), String> {
 /// Checks that a procedural texture's parameter `what` (a count of features across it)
 /// is 1 to its `size` in texels, the size itself first ([`checked_size`]): a count cannot
 /// be judged against a size out of range.
-fn per_texture(what: &str, v: u32, size: u32) -> Result<(), String> {
+fn per_texture(what: &'static str, v: u32, size: u32) -> Result<(), BadParameter> {
     checked_size(size)?;
     if v == 0 || v > size {
-        return Err(format!(
-            "{what} must be 1 to the texture's size ({size}), got {v}"
-        ));
+        let why = format!("{what} must be 1 to the texture's size ({size}), got {v}");
+        return Err(BadParameter::new(what, why));
     }
     Ok(())
 }
@@ -122,20 +139,22 @@ impl TextureMap {
     /// rasterised on `size` texels per side (the squares' edges are exact to a texel).
     ///
     /// # Errors
-    /// As [`TextureMap::from_rgb`]; `checks` of 0 or more than the texels.
+    /// A [`BadParameter`]: a `size` of 0 or above [`MAX_TEXTURE_SIDE`], `checks` of 0 or
+    /// more than the texels, a `repeat` that is not finite and > 0.
     pub fn checker(
         checks: (u32, u32),
         a: DVec3,
         b: DVec3,
         size: u32,
         repeat: DVec2,
-    ) -> Result<TextureMap, String> {
+    ) -> Result<TextureMap, BadParameter> {
         checked_size(size)?;
         if checks.0 == 0 || checks.1 == 0 || checks.0 > size || checks.1 > size {
-            return Err(format!(
+            let why = format!(
                 "checks must be 1 to the texture's size ({size}) along each side, got ({}, {})",
                 checks.0, checks.1
-            ));
+            );
+            return Err(BadParameter::new("checks", why));
         }
         Self::raster(size, repeat, |u, v| {
             let (i, j) = ((u * checks.0 as f64) as u32, (v * checks.1 as f64) as u32);
@@ -147,8 +166,8 @@ impl TextureMap {
     /// `duty` of each period, centred in it, and `a` elsewhere.
     ///
     /// # Errors
-    /// As [`TextureMap::from_rgb`]; `count` of 0 or more than the texels, `duty` outside
-    /// (0, 1).
+    /// A [`BadParameter`]: a `size` of 0 or above [`MAX_TEXTURE_SIDE`], `count` of 0 or
+    /// more than the texels, `duty` outside (0, 1), a `repeat` that is not finite and > 0.
     pub fn stripes(
         count: u32,
         duty: f64,
@@ -156,10 +175,11 @@ impl TextureMap {
         b: DVec3,
         size: u32,
         repeat: DVec2,
-    ) -> Result<TextureMap, String> {
+    ) -> Result<TextureMap, BadParameter> {
         per_texture("count", count, size)?;
         if !(duty > 0.0 && duty < 1.0) {
-            return Err(format!("duty must be in (0, 1), got {duty}"));
+            let why = format!("duty must be in (0, 1), got {}", cov_core::num(duty));
+            return Err(BadParameter::new("duty", why));
         }
         Self::raster(size, repeat, |_, v| {
             let f = (v * count as f64).fract();
@@ -171,7 +191,8 @@ impl TextureMap {
     /// `seed`, interpolated with smoothstep weights, mapped between colours `a` and `b`.
     ///
     /// # Errors
-    /// As [`TextureMap::from_rgb`]; `cells` of 0 or more than the texels.
+    /// A [`BadParameter`]: a `size` of 0 or above [`MAX_TEXTURE_SIDE`], `cells` of 0 or
+    /// more than the texels, a `repeat` that is not finite and > 0.
     pub fn noise(
         cells: u32,
         seed: u64,
@@ -179,7 +200,7 @@ impl TextureMap {
         b: DVec3,
         size: u32,
         repeat: DVec2,
-    ) -> Result<TextureMap, String> {
+    ) -> Result<TextureMap, BadParameter> {
         use rand::{Rng, SeedableRng};
         per_texture("cells", cells, size)?;
         let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
@@ -294,7 +315,11 @@ impl TextureMap {
 
     /// Rasterises `f(u, v)` (u, v in [0, 1), sampled at texel centres) on `size²` texels;
     /// its callers checked `size` ([`checked_size`]).
-    fn raster(size: u32, repeat: DVec2, f: impl Fn(f64, f64) -> DVec3) -> Result<TextureMap, String> {
+    ///
+    /// # Errors
+    /// A `repeat` that is not finite and > 0 (the only check of [`TextureMap::from_rgb`]
+    /// that a checked side leaves).
+    fn raster(size: u32, repeat: DVec2, f: impl Fn(f64, f64) -> DVec3) -> Result<TextureMap, BadParameter> {
         let n = size as usize;
         let mut rgb = Vec::with_capacity(n * n);
         for row in 0..n {
@@ -304,7 +329,7 @@ impl TextureMap {
                 rgb.push([c.x as f32, c.y as f32, c.z as f32]);
             }
         }
-        Self::from_rgb(size, size, rgb, repeat)
+        Self::from_rgb(size, size, rgb, repeat).map_err(|why| BadParameter::new("repeat", why))
     }
 
     /// Side lengths of level 0 (texels).

@@ -783,44 +783,52 @@ fn textures(desc: &SceneFile, dir: &Path) -> Result<(Vec<TextureMap>, Vec<String
     // The procedural textures' texels are known before any is made: too many, and none is.
     let mut texels = 0usize;
     for (name, t) in &desc.textures {
-        let side = match &t.value {
-            TextureDesc::Image { .. } => 0,
+        let (side, at) = match &t.value {
+            TextureDesc::Image { .. } => (0, t.ordinal),
             TextureDesc::Checker { size, .. }
             | TextureDesc::Stripes { size, .. }
-            | TextureDesc::Noise { size, .. } => {
-                size.unwrap_or(DEFAULT_TEXTURE_SIZE)
-                    .min(crate::texture::MAX_TEXTURE_SIDE) as usize
-            }
+            | TextureDesc::Noise { size, .. } => match size {
+                Some(s) => (s.value.min(crate::texture::MAX_TEXTURE_SIDE), s.ordinal),
+                None => (DEFAULT_TEXTURE_SIZE, t.ordinal),
+            },
         };
-        texels += side * side;
-        too_many_texels(texels, name, t.ordinal, false)?;
+        texels += side as usize * side as usize;
+        too_many_texels(texels, name, at, false)?;
     }
     // Then each image's, on top, as it is decoded.
     for (name, t) in &desc.textures {
-        let rep = |r: &Option<crate::scene::Repeat>| r.map_or(DVec2::ONE, |r| DVec2::new(r.0, r.1));
-        let size = |s: &Option<u32>| s.unwrap_or(DEFAULT_TEXTURE_SIZE);
-        // The map, and where an error in making it points (the file name, or the texture).
-        let (map, at) = match &t.value {
-            TextureDesc::Image { file, repeat } => (
-                TextureMap::load(&dir.join(&file.value), rep(repeat)),
-                file.ordinal,
-            ),
+        let rep = |r: &Option<At<crate::scene::Repeat>>| {
+            r.as_ref()
+                .map_or(DVec2::ONE, |r| DVec2::new(r.value.0, r.value.1))
+        };
+        let size = |s: &Option<At<u32>>| s.as_ref().map_or(DEFAULT_TEXTURE_SIZE, |s| s.value);
+        // Where a parameter is, if the file gives it; the texture's name if not.
+        let at = |p: Option<u32>| p.unwrap_or(t.ordinal);
+        let says = |e: &dyn std::fmt::Display| format!("texture `{}`: {e}", crate::echo(&name.value));
+        let map = match &t.value {
+            TextureDesc::Image { file, repeat } => {
+                TextureMap::load(&dir.join(&file.value), rep(repeat)).map_err(|e| (file.ordinal, says(&e)))?
+            }
             TextureDesc::Checker {
                 checks,
                 a,
                 b,
                 size: sz,
                 repeat,
-            } => (
-                TextureMap::checker(
-                    *checks,
-                    reflectance(a, name, "a")?,
-                    reflectance(b, name, "b")?,
-                    size(sz),
-                    rep(repeat),
-                ),
-                t.ordinal,
-            ),
+            } => TextureMap::checker(
+                checks.value,
+                reflectance(a, name, "a")?,
+                reflectance(b, name, "b")?,
+                size(sz),
+                rep(repeat),
+            )
+            .map_err(|e| {
+                let p = match e.name {
+                    "checks" => Some(checks.ordinal),
+                    _ => parameter(&e, sz, repeat),
+                };
+                (at(p), says(&e))
+            })?,
             TextureDesc::Stripes {
                 count,
                 duty,
@@ -828,17 +836,22 @@ fn textures(desc: &SceneFile, dir: &Path) -> Result<(Vec<TextureMap>, Vec<String
                 b,
                 size: sz,
                 repeat,
-            } => (
-                TextureMap::stripes(
-                    *count,
-                    duty.map_or(0.5, |d| d.0),
-                    reflectance(a, name, "a")?,
-                    reflectance(b, name, "b")?,
-                    size(sz),
-                    rep(repeat),
-                ),
-                t.ordinal,
-            ),
+            } => TextureMap::stripes(
+                count.value,
+                duty.as_ref().map_or(0.5, |d| d.value.0),
+                reflectance(a, name, "a")?,
+                reflectance(b, name, "b")?,
+                size(sz),
+                rep(repeat),
+            )
+            .map_err(|e| {
+                let p = match e.name {
+                    "count" => Some(count.ordinal),
+                    "duty" => duty.as_ref().map(|d| d.ordinal),
+                    _ => parameter(&e, sz, repeat),
+                };
+                (at(p), says(&e))
+            })?,
             TextureDesc::Noise {
                 cells,
                 a,
@@ -846,28 +859,45 @@ fn textures(desc: &SceneFile, dir: &Path) -> Result<(Vec<TextureMap>, Vec<String
                 seed,
                 size: sz,
                 repeat,
-            } => (
-                TextureMap::noise(
-                    *cells,
-                    seed.unwrap_or(0),
-                    reflectance(a, name, "a")?,
-                    reflectance(b, name, "b")?,
-                    size(sz),
-                    rep(repeat),
-                ),
-                t.ordinal,
-            ),
+            } => TextureMap::noise(
+                cells.value,
+                seed.unwrap_or(0),
+                reflectance(a, name, "a")?,
+                reflectance(b, name, "b")?,
+                size(sz),
+                rep(repeat),
+            )
+            .map_err(|e| {
+                let p = match e.name {
+                    "cells" => Some(cells.ordinal),
+                    _ => parameter(&e, sz, repeat),
+                };
+                (at(p), says(&e))
+            })?,
         };
-        let map = map.map_err(|e| (at, format!("texture `{}`: {e}", crate::echo(&name.value))))?;
-        if let TextureDesc::Image { .. } = t.value {
+        if let TextureDesc::Image { file, .. } = &t.value {
             let (w, h) = map.size();
             texels += w * h;
-            too_many_texels(texels, name, at, true)?;
+            too_many_texels(texels, name, file.ordinal, true)?;
         }
         maps.push(map);
         names.push(name.value.clone());
     }
     Ok((maps, names))
+}
+
+/// Where the parameter every procedural texture has that `e` names is written: its
+/// `size` or its `repeat` (`None`: not written, or another parameter).
+fn parameter(
+    e: &crate::texture::BadParameter,
+    size: &Option<At<u32>>,
+    repeat: &Option<At<crate::scene::Repeat>>,
+) -> Option<u32> {
+    match e.name {
+        "size" => size.as_ref().map(|s| s.ordinal),
+        "repeat" => repeat.as_ref().map(|r| r.ordinal),
+        _ => None,
+    }
 }
 
 /// Materials, their names, and their textures' indices.

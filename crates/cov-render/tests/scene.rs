@@ -580,6 +580,106 @@ fn values_are_said_as_written() {
     }
 }
 
+/// Mistakes in the text's tokens are placed where they are written, not where ron
+/// noticed them, and said in the author's words; so are a `)` too many or missing.
+#[test]
+fn token_mistakes_are_placed_where_they_are_written() {
+    let long = format!("{}.0", "9".repeat(400));
+    for (parts, want) in [
+        // A string's closing quote missing: it ran on to the shape's `"w"`.
+        (
+            vec![("{ \"w\": Diffuse", "{ \"w: Diffuse")],
+            "3:18: this string runs on to line 5: is its closing `\"` missing?".to_string(),
+        ),
+        (
+            vec![("material: \"w\")", "material: \"\\w\")")],
+            "5:70: `\\w` is no escape a string knows: write a backslash as `\\\\`".to_string(),
+        ),
+        (
+            vec![("Scene(\n", "Scene(\n    /* not closed\n")],
+            "2:5: this block comment is not closed: its `*/` is missing".to_string(),
+        ),
+        (
+            vec![("FOV", "\u{200B}40.0")],
+            "2:72: an invisible U+200B character here".to_string(),
+        ),
+        (
+            vec![("LOOK", "(0.0, 0x1, 0.0)")],
+            "2:56: `look_at`: value 2 = 0x1: a hexadecimal number".to_string(),
+        ),
+        (vec![("FOV", "4O.0")], "2:72: `fov` = 4O.0: not a number".to_string()),
+        (
+            vec![("FOV", long.as_str())],
+            "2:72: `fov` = 9999999999999999999999999999999999999999999999999999999999999999… (402 characters): beyond the largest number a float holds".to_string(),
+        ),
+        (
+            vec![("FOV", "40.0)")],
+            "2:76: `width` is missing from `Camera`: this `)` closes it before `width` is read; is it one too many?".to_string(),
+        ),
+        (
+            vec![(
+                "LENS",
+                ", lens: (aperture: 0.01, focus_distance: 2.0,\n    shutter: (open: 0.0, close: 0.01)",
+            )],
+            "3:5: `shutter` is no field of `Lens`: is the `)` that closes `lens` (at 2:99) missing before it?".to_string(),
+        ),
+    ] {
+        let e = error(&scene(&parts));
+        assert!(e.starts_with(&want), "{parts:?}: {e}");
+    }
+}
+
+/// A procedural texture's parameter out of range is pointed at where it is written, and
+/// named; a parameter left at its default is the texture's, at its name.
+#[test]
+fn a_texture_parameter_is_pointed_at() {
+    // Line 3 is `    textures: { "t": TEXTURE },`: the texture starts at column 22.
+    for (texture, want) in [
+        (
+            "Checker(checks: (0, 2), a: (1.0, 1.0, 1.0), b: (0.0, 0.0, 0.0))",
+            "3:38: texture `t`: checks must be 1 to the texture's size (1024) along each side, got (0, 2)",
+        ),
+        (
+            "Checker(checks: (2, 2), a: (1.0, 1.0, 1.0), b: (0.0, 0.0, 0.0), size: 0)",
+            "3:92: texture `t`: size must be 1 to 4096 texels, got 0",
+        ),
+        (
+            "Stripes(count: 0, a: (1.0, 1.0, 1.0), b: (0.0, 0.0, 0.0))",
+            "3:37: texture `t`: count must be 1 to the texture's size (1024), got 0",
+        ),
+        (
+            "Stripes(count: 4, duty: 1.5, a: (1.0, 1.0, 1.0), b: (0.0, 0.0, 0.0))",
+            "3:46: texture `t`: duty must be in (0, 1), got 1.5",
+        ),
+        (
+            "Noise(cells: 16, a: (1.0, 1.0, 1.0), b: (0.0, 0.0, 0.0), size: 8)",
+            "3:35: texture `t`: cells must be 1 to the texture's size (8), got 16",
+        ),
+        (
+            "Noise(cells: 4, a: (1.0, 1.0, 1.0), b: (0.0, 0.0, 0.0), size: 5000)",
+            "3:84: texture `t`: size must be 1 to 4096 texels, got 5000",
+        ),
+        (
+            "Noise(cells: 4, a: (1.0, 1.0, 1.0), b: (0.0, 0.0, 0.0), repeat: (1.0, 0.0))",
+            "3:86: `repeat`: each entry must be finite and > 0, got (1, 0)",
+        ),
+        // Three of the largest side are more texels than a scene holds: at the third's size.
+        (
+            "Noise(cells: 4, a: (1.0, 1.0, 1.0), b: (0.0, 0.0, 0.0), size: 4096), \"u\": \
+             Stripes(count: 4, a: (1.0, 1.0, 1.0), b: (0.0, 0.0, 0.0), size: 4096), \"v\": \
+             Checker(checks: (2, 2), a: (1.0, 1.0, 1.0), b: (0.0, 0.0, 0.0), size: 4096)",
+            "3:242: texture `v` would bring the scene's textures to",
+        ),
+    ] {
+        let t = BASE.replace(
+            "    materials:",
+            &format!("    textures: {{ \"t\": {texture} }},\n    materials:"),
+        );
+        let e = error(&scene_from(&t));
+        assert!(e.starts_with(want), "{texture}: {e}");
+    }
+}
+
 /// A path's depth is a count the user controls: 1 to 32, refused where it is written,
 /// 2 when left out.
 #[test]
@@ -648,7 +748,7 @@ fn a_syntax_error_says_what_it_found() {
     // Each edit of the scene, and how the error's line ends.
     let cases: &[((&str, &str), &str)] = &[
         (("FOV", "40.0,,"), "Expected identifier, found `,`"),
-        (("FOV", "4o"), "Expected comma, found `o`"),
+        (("FOV", "4o"), "`fov` = 4o: not a number"),
         (("FOV", "40.0 width"), "Expected comma, found `width`"),
         // A value of the wrong type names its field and what it needs.
         (("FOV", "\"wide\""), "`fov` = \"wide\": expected a number"),

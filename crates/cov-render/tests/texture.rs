@@ -53,7 +53,7 @@ fn texture_errors_are_positioned_and_one_line() {
         ),
         (
             base.replace("size: 512", "size: 100000"),
-            "s.ron:3:30: texture `board`: size must be 1 to 4096 texels, got 100000",
+            "s.ron:3:100: texture `board`: size must be 1 to 4096 texels, got 100000",
         ),
         (
             base.replace(
