@@ -37,8 +37,8 @@ mod source;
 pub use error::PathError;
 pub use eval::{EvalStep, Evaluation, StepReport};
 pub use path::{
-    MAX_PATH_BYTES, Path, decimal_for_whole, expected_value, not_decimal, number_start, ron_options,
-    whole_number_at,
+    MAX_PATH_BYTES, Path, beyond_float, decimal_for_whole, expected_value, not_decimal, number_start,
+    ron_options, whole_number_at,
 };
 pub use registry::{Entry, Registry};
 pub use scan::{

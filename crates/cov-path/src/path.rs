@@ -149,6 +149,14 @@ fn explain(
         && let Some(name) = tail.split('`').next()
         && let Some((l, c)) = crate::scan::field_position(text, line, col, name)
     {
+        // A number a float cannot hold, which the check reports as `inf` or 0.
+        if let Some((found, _, value)) = crate::scan::field_at(text, l, c + name.chars().count() + 1)
+            && found == name
+            && let Some(words) = beyond_float(&value)
+        {
+            let value = cov_core::echo(&value);
+            return (l, c, format!("{prefix}parameter `{name}` = {value}: {words}"));
+        }
         return (l, c, msg);
     }
     (line, col, msg)
@@ -267,6 +275,23 @@ pub fn not_decimal(written: &str) -> Option<&'static str> {
         "binary" => "a binary number; write it in decimal (`0b101` is 5.0)",
         _ => "an octal number; write it in decimal (`0o17` is 15.0)",
     })
+}
+
+/// What is wrong with `written`, a number as a file writes it, that a float cannot hold:
+/// too large (`1e400`, read as infinite) or, not zero, too small (`1e-400`, read as 0). A
+/// check of the value read would say "got inf" or "got 0" of a value the user did not
+/// write. `None` for any other.
+pub fn beyond_float(written: &str) -> Option<&'static str> {
+    let w = written.trim();
+    let v = w.parse::<f64>().ok()?;
+    let mantissa = w.split(['e', 'E']).next().unwrap_or("");
+    if v.is_infinite() && !w.to_ascii_lowercase().contains("inf") {
+        Some("beyond the largest number a float holds (about 1.8e308)")
+    } else if v == 0.0 && mantissa.chars().any(|c| matches!(c, '1'..='9')) {
+        Some("below the smallest number a float holds (about 4.9e-324), read as 0")
+    } else {
+        None
+    }
 }
 
 /// What ron's message that a value has the wrong type says was expected, in a file

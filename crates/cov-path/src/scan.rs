@@ -309,17 +309,22 @@ fn value_from(written: &[char], chars: &[char], mut v: usize) -> String {
     // As written, but a comment (blank in `chars`) and every run of blanks read as one
     // space, so that a value written over several lines echoes on one.
     let mut out = String::new();
+    // Characters in `out`, counted as they come (counting `out` each time took a number of
+    // a million digits quadratic time).
+    let mut n = 0usize;
     for (c, code) in written[v..w].iter().zip(&chars[v..w]) {
         if code.is_whitespace() {
             if !out.ends_with(' ') {
                 out.push(' ');
+                n += 1;
             }
         } else {
             out.push(*c);
+            n += 1;
         }
         // Past 40 characters, at the first blank or bracket: a number of 5,000 digits is
         // read whole, so that what it is (too large for a float) can be told.
-        if out.chars().count() >= 40 && !code.is_alphanumeric() && !matches!(code, '.' | '_' | '-' | '+') {
+        if n >= 40 && !code.is_alphanumeric() && !matches!(code, '.' | '_' | '-' | '+') {
             break;
         }
     }
@@ -492,9 +497,12 @@ fn bad_escape(text: &str, line: usize, col: usize) -> Option<((usize, usize), St
 }
 
 /// Errors of the text's tokens rather than its structure, which ron places where it
-/// noticed them, not where they are: a string whose closing `"` is missing (it runs on
-/// over line breaks to the next `"`), a backslash that starts no escape (ron points at
-/// the string's start), a block comment not closed (ron points at the end of the file).
+/// noticed them, not where they are, or says in a parser's words: a string whose closing
+/// `"` is missing (it runs on over line breaks to the next `"`, or to the end), a
+/// backslash that starts no escape (ron points at the string's start), a block comment
+/// not closed (ron points at the end of the file), a typographic quote or a dash pasted
+/// for `"` or `-`, a `#` comment, text after the file's value, a map's key without
+/// quotes, a comma left off at a line's end (ron points at the next line).
 /// `message` is ron's, at `(line, col)`; the place and the message, or `None`.
 pub fn token_error(text: &str, line: usize, col: usize, message: &str) -> Option<((usize, usize), String)> {
     if message.starts_with("Unclosed block comment") {
@@ -511,11 +519,130 @@ pub fn token_error(text: &str, line: usize, col: usize, message: &str) -> Option
             ),
         ));
     }
+    if message.starts_with("Expected end of string") {
+        return Some((
+            (line, col),
+            "this string is not closed: its closing `\"` is missing".into(),
+        ));
+    }
+    let text = text.strip_prefix('\u{feff}').unwrap_or(text);
+    let written: Vec<char> = text.chars().collect();
+    let chars = code_of(&written);
+    let pos = char_positions(&chars);
+    let at = pos.iter().position(|&p| p >= (line, col)).unwrap_or(chars.len());
+    // The first character at or after the error that is not blank or a comment.
+    let next = (at..chars.len()).find(|&i| !chars[i].is_whitespace());
+    if let Some(i) = next
+        && let Some(words) = lookalike(written[i])
+    {
+        return Some((pos[i], words));
+    }
+    if message.starts_with("Expected an `#![enable(") && chars[..at.min(chars.len())].last() == Some(&'#') {
+        return Some((
+            pos[at - 1],
+            "`#` does not start a comment: write `//` (or `/* … */`)".into(),
+        ));
+    }
+    if message.starts_with("Non-whitespace trailing characters") {
+        let i = next?;
+        return Some((
+            pos[i],
+            format!(
+                "`{}` after the end: the file's value was closed before it (a `)` too many, or a second value?)",
+                cov_core::echo(&token(&written, i))
+            ),
+        ));
+    }
+    // A name where a map's key, a string, belongs: `white: Diffuse(…)`.
+    if message.starts_with("Expected string")
+        && let Some(i) = next
+        && (chars[i].is_alphabetic() || chars[i] == '_')
+    {
+        let name = token(&written, i);
+        let after = (i + name.chars().count()..chars.len()).find(|&j| !chars[j].is_whitespace());
+        if after.is_some_and(|j| chars[j] == ':') {
+            return Some((
+                pos[i],
+                format!(
+                    "a name here is written in double quotes: `\"{}\"`",
+                    cov_core::echo(&name)
+                ),
+            ));
+        }
+    }
+    // A decimal comma, `radius: 1,5`: the `5` read where a name belongs.
+    if let Some(i) = next
+        && chars[i].is_ascii_digit()
+        && i >= 2
+        && chars[i - 1] == ','
+        && chars[i - 2].is_ascii_digit()
+    {
+        let start = (0..i - 1)
+            .rev()
+            .find(|&j| !(chars[j].is_ascii_digit() || chars[j] == '-'))
+            .map_or(0, |j| j + 1);
+        let number: String = written[start..i].iter().collect::<String>() + &token(&written, i);
+        return Some((
+            pos[start],
+            format!(
+                "`{}`: a comma ends a value; a decimal number is written with a point (`{}`)",
+                cov_core::echo(&number),
+                cov_core::echo(&number.replacen(',', ".", 1))
+            ),
+        ));
+    }
+    // A comma left off at the end of a line: said where it belongs, after the last value.
+    if message == "Expected comma"
+        && let Some(i) = next
+        && let Some(last) = (0..at.min(chars.len()))
+            .rev()
+            .find(|&j| !chars[j].is_whitespace())
+        && pos[last].0 < pos[i].0
+    {
+        let (l, c) = pos[last];
+        return Some((
+            (l, c + 1),
+            format!(
+                "a `,` is missing here, before `{}` on line {}",
+                cov_core::echo(&token(&written, i)),
+                pos[i].0
+            ),
+        ));
+    }
     let (at, end) = string_across_lines(text, line, col)?;
     Some((
         at,
         format!("this string runs on to line {end}: is its closing `\"` missing?"),
     ))
+}
+
+/// What to write instead of `c`, a character pasted from a word processor that looks like
+/// one the file's syntax reads: a typographic quote, a minus sign or a dash. `None` for
+/// any other.
+fn lookalike(c: char) -> Option<String> {
+    let (what, write) = match c {
+        '\u{201C}' | '\u{201D}' | '\u{201E}' | '\u{2018}' | '\u{2019}' | '\u{00AB}' | '\u{00BB}' => {
+            ("a typographic quote", "\"")
+        }
+        '\u{2212}' => ("a typographic minus sign", "-"),
+        '\u{2013}' | '\u{2014}' | '\u{2010}' | '\u{2011}' => ("a dash", "-"),
+        _ => return None,
+    };
+    Some(format!(
+        "`{c}` (U+{:04X}) is {what} (it often comes from pasting text): write `{write}`",
+        u32::from(c)
+    ))
+}
+
+/// The word (letters, digits, `_`, `.`, signs) that starts at index `i` of `chars`, or its
+/// one character, at most 24 characters.
+fn token(chars: &[char], i: usize) -> String {
+    let word = |c: &char| c.is_alphanumeric() || matches!(*c, '_' | '.' | '-' | '+');
+    if chars.get(i).is_some_and(word) {
+        chars[i..].iter().take_while(|c| word(c)).take(24).collect()
+    } else {
+        chars.get(i).map(char::to_string).unwrap_or_default()
+    }
 }
 
 /// The field whose value is the parenthesised struct or tuple that encloses `(line, col)`

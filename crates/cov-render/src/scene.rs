@@ -682,11 +682,26 @@ fn truncated(m: &str, written: &str) -> bool {
     value.is_finite() && value.fract() != 0.0 && got.is_some_and(|g| g == value.trunc())
 }
 
-/// Whether `written` is a number too large for a float (`1e400`), which the parser reads
-/// as infinite: a check would then say "got inf" of a value the user did not write.
-fn overflows(written: &str) -> bool {
-    let w = written.trim();
-    !w.to_ascii_lowercase().contains("inf") && w.parse::<f64>().is_ok_and(f64::is_infinite)
+/// The digits after the comma if the whole number `written`, the value of the field at
+/// `(line, col)` of `text`, is followed by a comma and a digit: `0,4`, a decimal comma,
+/// read as 0 and a next entry.
+fn decimal_comma(text: &str, line: usize, col: usize, written: &str) -> Option<String> {
+    if !written.chars().all(|c| c.is_ascii_digit() || c == '-') {
+        return None;
+    }
+    let (l, c) = cov_path::value_position(text, line, col)?;
+    let text = text.strip_prefix('\u{feff}').unwrap_or(text);
+    let row: Vec<char> = text.lines().nth(l.checked_sub(1)?)?.chars().collect();
+    let after = c.checked_sub(1)? + written.chars().count();
+    if row.get(after) != Some(&',') {
+        return None;
+    }
+    let digits: String = row[after + 1..]
+        .iter()
+        .take_while(|c| c.is_ascii_digit())
+        .take(24)
+        .collect();
+    (!digits.is_empty()).then_some(digits)
 }
 
 /// ron's message `message` at `(line, col)` of `text` said of a tuple's field, when it
@@ -850,11 +865,16 @@ impl SceneFile {
                 at = value_at();
             } else if let ron::Error::Message(_) = &e.code
                 && let Some((name, _, value)) = field()
-                && overflows(&value)
+                && let Some(words) = cov_path::beyond_float(&value)
+            {
+                message = format!("`{name}` = {}: {words}", cov_core::echo(&value));
+                at = value_at();
+            } else if let ron::Error::Message(_) = &e.code
+                && let Some((name, _, value)) = field()
+                && let Some(digits) = decimal_comma(text, line, col, &value)
             {
                 message = format!(
-                    "`{name}` = {}: beyond the largest number a float holds (about 1.8e308)",
-                    cov_core::echo(&value)
+                    "`{name}` = {value},{digits}: a comma ends a value; a decimal number is written with a point (`{value}.{digits}`)"
                 );
                 at = value_at();
             } else if let ron::Error::Message(m) = &e.code
@@ -871,7 +891,9 @@ impl SceneFile {
             {
                 // A value of the wrong type: its field, what it holds and what it needs.
                 let value = cov_core::echo(&value);
-                message = if what.is_empty() {
+                message = if what.is_empty() && value.starts_with('-') {
+                    format!("`{name}` = {value}: must not be negative")
+                } else if what.is_empty() {
                     format!("`{name}` = {value} is out of range for a whole number")
                 } else {
                     format!("`{name}` = {value}: expected {what}")

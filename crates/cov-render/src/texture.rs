@@ -261,7 +261,7 @@ impl TextureMap {
                     one(&e)
                 ),
             })?,
-            Err(e) => return Err(one(&e)),
+            Err(e) => return Err(format!("{} (the file may be cut short or damaged)", one(&e))),
         };
         if w == 0 || h == 0 || w > MAX_TEXTURE_SIDE || h > MAX_TEXTURE_SIDE {
             return Err(format!(
@@ -297,7 +297,7 @@ impl TextureMap {
                 })?;
                 return Self::from_rgb(w, h, grey, repeat);
             }
-            Err(e) => return Err(one(&e)),
+            Err(e) => return Err(format!("{} (the file may be cut short or damaged)", one(&e))),
         };
         let srgb = |c: f32| {
             if c <= 0.04045 {

@@ -616,6 +616,54 @@ fn token_mistakes_are_placed_where_they_are_written() {
             vec![("FOV", "40.0)")],
             "2:76: `width` is missing from `Camera`: this `)` closes it before `width` is read; is it one too many?".to_string(),
         ),
+        // Pasted characters that look like the syntax's own.
+        (
+            vec![("{ \"w\": Diffuse", "{ \u{201C}w\u{201D}: Diffuse")],
+            "3:18: `\u{201C}` (U+201C) is a typographic quote (it often comes from pasting text): write `\"`".to_string(),
+        ),
+        (
+            vec![("LOOK", "(0.0, \u{2212}1.0, 0.0)")],
+            "2:56: `\u{2212}` (U+2212) is a typographic minus sign (it often comes from pasting text): write `-`".to_string(),
+        ),
+        // Habits of other formats: a `#` comment, a key without quotes, a decimal comma.
+        (
+            vec![("Scene(\n", "# a comment\nScene(\n")],
+            "1:1: `#` does not start a comment: write `//` (or `/* … */`)".to_string(),
+        ),
+        (
+            vec![("{ \"w\": Diffuse", "{ w: Diffuse")],
+            "3:18: a name here is written in double quotes: `\"w\"`".to_string(),
+        ),
+        (
+            vec![("radius: 0.5, material: \"w\")", "radius: 0,5, material: \"w\")")],
+            "5:54: `radius` = 0,5: a comma ends a value; a decimal number is written with a point (`0.5`)".to_string(),
+        ),
+        (
+            vec![("radius: 0.5, material: \"w\")", "radius: 1,5, material: \"w\")")],
+            "5:54: `1,5`: a comma ends a value; a decimal number is written with a point (`1.5`)".to_string(),
+        ),
+        // A comma left off at a line's end: after the value, not at the next line.
+        (
+            vec![("fov: FOV, ", "fov: 40.0\n        ")],
+            "2:76: a `,` is missing here, before `width` on line 3".to_string(),
+        ),
+        // Text after the scene, a string never closed, numbers a float cannot hold.
+        (
+            vec![("SHAPE],\n)", "SHAPE],\n))")],
+            "6:2: `)` after the end: the file's value was closed before it".to_string(),
+        ),
+        (
+            vec![("radius: 0.5, material: \"w\")", "radius: 0.5, material: \"w)")],
+            "5:69: this string is not closed: its closing `\"` is missing".to_string(),
+        ),
+        (
+            vec![("FOV", "1e-400")],
+            "2:72: `fov` = 1e-400: below the smallest number a float holds (about 4.9e-324), read as 0".to_string(),
+        ),
+        (
+            vec![("width: 8", "width: -8")],
+            "2:85: `width` = -8: must not be negative".to_string(),
+        ),
         (
             vec![(
                 "LENS",
@@ -688,7 +736,7 @@ fn a_path_depth_is_bounded_where_it_is_written() {
     for (d, want) in [
         ("0", "2:16: `max_depth` must be 1 to 32 surface vertices, got 0"),
         ("33", "2:16: `max_depth` must be 1 to 32 surface vertices, got 33"),
-        ("-1", "2:16: `max_depth` = -1 is out of range for a whole number"),
+        ("-1", "2:16: `max_depth` = -1: must not be negative"),
         ("2.5", "2:16: `max_depth` = 2.5: expected a whole number"),
         (
             "Some(0)",
