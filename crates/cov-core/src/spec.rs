@@ -141,6 +141,18 @@ impl Param {
         self.of(value).error(expected)
     }
 
+    /// The error for a list parameter of `len` values where `expected` (in words,
+    /// `"1 or 2 components"`) belongs: `Moving: parameter `velocity`: expected 1 or 2
+    /// components, got 3`.
+    #[cold]
+    pub fn wrong_length(&self, len: usize, expected: impl Into<String>) -> CovError {
+        CovError::Shape {
+            what: format!("{}: parameter `{}`", self.operator, self.name),
+            expected: expected.into(),
+            got: format!("{len}"),
+        }
+    }
+
     /// `value` if it is finite and `ok(value)`, else the error naming this parameter, with
     /// `expected()` (built only on failure) saying the domain.
     ///

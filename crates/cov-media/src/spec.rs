@@ -9,11 +9,7 @@ fn hessian(p: &Param, h: &[f64]) -> Result<[f64; 3], CovError> {
     match h {
         [a] => Ok([*a, 0.0, 0.0]),
         [a, b, c] => Ok([*a, *b, *c]),
-        _ => Err(CovError::Shape {
-            what: format!("{}: {}", p.operator, p.name),
-            expected: "[hxx] or [hxx, hxy, hyy]".into(),
-            got: format!("{} numbers", h.len()),
-        }),
+        _ => Err(p.wrong_length(h.len(), "[hxx] or [hxx, hxy, hyy]")),
     }
 }
 

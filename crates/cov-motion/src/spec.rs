@@ -10,11 +10,7 @@ fn pad(p: &Param, v: &[f64]) -> Result<[f64; 2], CovError> {
         [] => Ok([0.0, 0.0]),
         [a] => Ok([*a, 0.0]),
         [a, b] => Ok([*a, *b]),
-        _ => Err(CovError::Shape {
-            what: format!("{}: {}", p.operator, p.name),
-            expected: "1 or 2 components".into(),
-            got: format!("{}", v.len()),
-        }),
+        _ => Err(p.wrong_length(v.len(), "1 or 2 components")),
     }
 }
 

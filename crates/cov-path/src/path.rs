@@ -144,8 +144,12 @@ fn explain(
         };
         return (line, col, message);
     }
-    // `parameter `name``: point at the parameter where it is written.
-    if let Some(tail) = rest.split("parameter `").nth(1)
+    // `parameter `name`` (a source's `std `name``): point at the parameter where it is
+    // written.
+    if let Some(tail) = rest
+        .split("parameter `")
+        .nth(1)
+        .or_else(|| rest.strip_prefix("Gaussian source: std `"))
         && let Some(name) = tail.split('`').next()
         && let Some((l, c)) = crate::scan::field_position(text, line, col, name)
     {

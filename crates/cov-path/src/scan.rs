@@ -505,6 +505,21 @@ fn bad_escape(text: &str, line: usize, col: usize) -> Option<((usize, usize), St
 /// quotes, a comma left off at a line's end (ron points at the next line).
 /// `message` is ron's, at `(line, col)`; the place and the message, or `None`.
 pub fn token_error(text: &str, line: usize, col: usize, message: &str) -> Option<((usize, usize), String)> {
+    // The other kind of file: a scene given where a path belongs, or a path where a scene.
+    for (found, words) in [
+        (
+            "Expected struct `Path` but found `Scene`",
+            "this file holds a scene (`Scene(…)`), and this command reads a light path (`Path(…)`): render a scene with `covtrace render`",
+        ),
+        (
+            "Expected struct `Scene` but found `Path`",
+            "this file holds a light path (`Path(…)`), and this command reads a scene (`Scene(…)`): trace a path with `covtrace eval`",
+        ),
+    ] {
+        if message.starts_with(found) {
+            return Some(((line, col), words.into()));
+        }
+    }
     if message.starts_with("Unclosed block comment") {
         let at = unclosed_comment(text)?;
         return Some((at, "this block comment is not closed: its `*/` is missing".into()));

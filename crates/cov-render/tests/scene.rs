@@ -675,6 +675,12 @@ fn token_mistakes_are_placed_where_they_are_written() {
         let e = error(&scene(&parts));
         assert!(e.starts_with(&want), "{parts:?}: {e}");
     }
+    // A light path given where a scene belongs says which command reads it.
+    let e = error("// a path\nPath(source: Gaussian(x: 0.3), operators: [])\n");
+    assert!(
+        e.starts_with("2:1: this file holds a light path (`Path(…)`), and this command reads a scene (`Scene(…)`): trace a path with `covtrace eval`"),
+        "{e}"
+    );
 }
 
 /// A procedural texture's parameter out of range is pointed at where it is written, and
