@@ -802,12 +802,19 @@ fn textures(desc: &SceneFile, dir: &Path) -> Result<(Vec<TextureMap>, Vec<String
                 .map_or(DVec2::ONE, |r| DVec2::new(r.value.0, r.value.1))
         };
         let size = |s: &Option<At<u32>>| s.as_ref().map_or(DEFAULT_TEXTURE_SIZE, |s| s.value);
-        // Where a parameter is, if the file gives it; the texture's name if not.
-        let at = |p: Option<u32>| p.unwrap_or(t.ordinal);
         let says = |e: &dyn std::fmt::Display| format!("texture `{}`: {e}", crate::echo(&name.value));
-        let map = match &t.value {
+        // A procedural texture: the map, and where each parameter it may refuse is written
+        // (`None`: left at its default, said at the texture's name).
+        let (made, own, sz, repeat) = match &t.value {
             TextureDesc::Image { file, repeat } => {
-                TextureMap::load(&dir.join(&file.value), rep(repeat)).map_err(|e| (file.ordinal, says(&e)))?
+                let map = TextureMap::load(&dir.join(&file.value), rep(repeat))
+                    .map_err(|e| (file.ordinal, says(&e)))?;
+                let (w, h) = map.size();
+                texels += w * h;
+                too_many_texels(texels, name, file.ordinal, true)?;
+                maps.push(map);
+                names.push(name.value.clone());
+                continue;
             }
             TextureDesc::Checker {
                 checks,
@@ -815,20 +822,18 @@ fn textures(desc: &SceneFile, dir: &Path) -> Result<(Vec<TextureMap>, Vec<String
                 b,
                 size: sz,
                 repeat,
-            } => TextureMap::checker(
-                checks.value,
-                reflectance(a, name, "a")?,
-                reflectance(b, name, "b")?,
-                size(sz),
-                rep(repeat),
-            )
-            .map_err(|e| {
-                let p = match e.name {
-                    "checks" => Some(checks.ordinal),
-                    _ => parameter(&e, sz, repeat),
-                };
-                (at(p), says(&e))
-            })?,
+            } => (
+                TextureMap::checker(
+                    checks.value,
+                    reflectance(a, name, "a")?,
+                    reflectance(b, name, "b")?,
+                    size(sz),
+                    rep(repeat),
+                ),
+                [("checks", Some(checks.ordinal)), ("", None)],
+                sz,
+                repeat,
+            ),
             TextureDesc::Stripes {
                 count,
                 duty,
@@ -836,22 +841,22 @@ fn textures(desc: &SceneFile, dir: &Path) -> Result<(Vec<TextureMap>, Vec<String
                 b,
                 size: sz,
                 repeat,
-            } => TextureMap::stripes(
-                count.value,
-                duty.as_ref().map_or(0.5, |d| d.value.0),
-                reflectance(a, name, "a")?,
-                reflectance(b, name, "b")?,
-                size(sz),
-                rep(repeat),
-            )
-            .map_err(|e| {
-                let p = match e.name {
-                    "count" => Some(count.ordinal),
-                    "duty" => duty.as_ref().map(|d| d.ordinal),
-                    _ => parameter(&e, sz, repeat),
-                };
-                (at(p), says(&e))
-            })?,
+            } => (
+                TextureMap::stripes(
+                    count.value,
+                    duty.as_ref().map_or(0.5, |d| d.value.0),
+                    reflectance(a, name, "a")?,
+                    reflectance(b, name, "b")?,
+                    size(sz),
+                    rep(repeat),
+                ),
+                [
+                    ("count", Some(count.ordinal)),
+                    ("duty", duty.as_ref().map(|d| d.ordinal)),
+                ],
+                sz,
+                repeat,
+            ),
             TextureDesc::Noise {
                 cells,
                 a,
@@ -859,45 +864,36 @@ fn textures(desc: &SceneFile, dir: &Path) -> Result<(Vec<TextureMap>, Vec<String
                 seed,
                 size: sz,
                 repeat,
-            } => TextureMap::noise(
-                cells.value,
-                seed.unwrap_or(0),
-                reflectance(a, name, "a")?,
-                reflectance(b, name, "b")?,
-                size(sz),
-                rep(repeat),
-            )
-            .map_err(|e| {
-                let p = match e.name {
-                    "cells" => Some(cells.ordinal),
-                    _ => parameter(&e, sz, repeat),
-                };
-                (at(p), says(&e))
-            })?,
+            } => (
+                TextureMap::noise(
+                    cells.value,
+                    seed.unwrap_or(0),
+                    reflectance(a, name, "a")?,
+                    reflectance(b, name, "b")?,
+                    size(sz),
+                    rep(repeat),
+                ),
+                [("cells", Some(cells.ordinal)), ("", None)],
+                sz,
+                repeat,
+            ),
         };
-        if let TextureDesc::Image { file, .. } = &t.value {
-            let (w, h) = map.size();
-            texels += w * h;
-            too_many_texels(texels, name, file.ordinal, true)?;
-        }
+        let map = made.map_err(|e| {
+            let written = [
+                ("size", sz.as_ref().map(|s| s.ordinal)),
+                ("repeat", repeat.as_ref().map(|r| r.ordinal)),
+            ];
+            let place = own
+                .iter()
+                .chain(&written)
+                .find(|(n, _)| *n == e.name)
+                .and_then(|(_, p)| *p);
+            (place.unwrap_or(t.ordinal), says(&e))
+        })?;
         maps.push(map);
         names.push(name.value.clone());
     }
     Ok((maps, names))
-}
-
-/// Where the parameter every procedural texture has that `e` names is written: its
-/// `size` or its `repeat` (`None`: not written, or another parameter).
-fn parameter(
-    e: &crate::texture::BadParameter,
-    size: &Option<At<u32>>,
-    repeat: &Option<At<crate::scene::Repeat>>,
-) -> Option<u32> {
-    match e.name {
-        "size" => size.as_ref().map(|s| s.ordinal),
-        "repeat" => repeat.as_ref().map(|r| r.ordinal),
-        _ => None,
-    }
 }
 
 /// Materials, their names, and their textures' indices.
