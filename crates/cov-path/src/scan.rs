@@ -585,8 +585,11 @@ pub fn token_error(text: &str, line: usize, col: usize, message: &str) -> Option
             ));
         }
     }
-    // A decimal comma, `radius: 1,5`: the `5` read where a name belongs.
-    if let Some(i) = next
+    // A decimal comma, `radius: 1,5`: the `5` read where a field's name belongs (in a
+    // tuple, `(8,8,3)`, the digit after a comma is a value, and the error is another;
+    // a path's message starts with its operators' names).
+    if (message.contains("Expected identifier") || message.contains("Found invalid std identifier"))
+        && let Some(i) = next
         && chars[i].is_ascii_digit()
         && i >= 2
         && chars[i - 1] == ','

@@ -642,6 +642,11 @@ fn token_mistakes_are_placed_where_they_are_written() {
             vec![("radius: 0.5, material: \"w\")", "radius: 1,5, material: \"w\")")],
             "5:54: `1,5`: a comma ends a value; a decimal number is written with a point (`1.5`)".to_string(),
         ),
+        // A tuple written without blanks is no decimal comma.
+        (
+            vec![("LOOK", "(0.0,1.0,0.0,2)")],
+            "2:63: `look_at` has more than 3 values (found `2`)".to_string(),
+        ),
         // A comma left off at a line's end: after the value, not at the next line.
         (
             vec![("fov: FOV, ", "fov: 40.0\n        ")],
