@@ -27,6 +27,18 @@ pub enum CovError {
         /// What the domain is, in words (e.g. "must be > 0").
         expected: String,
     },
+    /// Parameters that exclude each other were given together, or none of a required
+    /// choice was (`Curvature(k: 2, kx: 1)`): said of the parameter to change, with the
+    /// forms the operator takes.
+    #[error("{operator}: parameter `{parameter}`: {expected}")]
+    Choice {
+        /// Operator that rejected the combination.
+        operator: String,
+        /// The parameter the message is about (where a path author looks).
+        parameter: String,
+        /// What to give instead, in words.
+        expected: String,
+    },
     /// An operator needs an axis the layout does not have.
     #[error("axis `{axis}` is not in the layout of size {layout}")]
     MissingAxis {

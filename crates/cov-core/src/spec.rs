@@ -141,6 +141,18 @@ impl Param {
         self.of(value).error(expected)
     }
 
+    /// The error for this parameter given with one it excludes, or for a choice of forms
+    /// of which none was given (`expected`: the forms, in words): `Curvature: parameter
+    /// `kx`: not with `k`; give either `k` alone or …`.
+    #[cold]
+    pub fn choice(&self, expected: impl Into<String>) -> CovError {
+        CovError::Choice {
+            operator: self.operator.to_string(),
+            parameter: self.name.to_string(),
+            expected: expected.into(),
+        }
+    }
+
     /// The error for a list parameter of `len` values where `expected` (in words,
     /// `"1 or 2 components"`) belongs: `Moving: parameter `velocity`: expected 1 or 2
     /// components, got 3`.

@@ -48,12 +48,15 @@ impl Build for CurvatureSpec {
             (None, kx, ky) => {
                 Curvature::checked(kx.unwrap_or(0.0), ky.unwrap_or(0.0), spec.angle.unwrap_or(0.0))
             }
-            (k, _, _) => {
-                let [k_, kx, ky, angle] = [&Self::K, &Self::KX, &Self::KY, &Self::ANGLE].map(|p| p.name);
-                Err(Self::K.error(
-                    k.unwrap_or(f64::NAN),
-                    format!("give either `{k_}` alone or the principal form `{kx}`, `{ky}`, `{angle}`"),
-                ))
+            _ => {
+                let [k, kx, ky, angle] = [&Self::K, &Self::KX, &Self::KY, &Self::ANGLE];
+                // `k` is given with one of the principal form: said of that one.
+                let given = [(kx, spec.kx), (ky, spec.ky), (angle, spec.angle)];
+                let other = given.iter().find(|(_, v)| v.is_some()).map_or(kx, |(p, _)| *p);
+                Err(other.choice(format!(
+                    "not with `{}`; give either `{}` alone or the principal form `{}`, `{}`, `{}`",
+                    k.name, k.name, kx.name, ky.name, angle.name
+                )))
             }
         }
     }

@@ -78,17 +78,31 @@ impl Build for TextureSpec {
                 (w, 0.0, w)
             }
             (None, Some(sxx)) => (sxx, spec.sxy.unwrap_or(0.0), spec.syy.unwrap_or(sxx)),
-            _ => {
-                let (f, xx, xy, yy) = (
-                    TextureSpec::FEATURE.name,
-                    TextureSpec::SXX.name,
-                    TextureSpec::SXY.name,
-                    TextureSpec::SYY.name,
+            (f, _) => {
+                let [feature, sxx, sxy, syy] = [
+                    &TextureSpec::FEATURE,
+                    &TextureSpec::SXX,
+                    &TextureSpec::SXY,
+                    &TextureSpec::SYY,
+                ];
+                let forms = format!(
+                    "give either `{}` or the spectrum `{}` (with optional `{}`, `{}`)",
+                    feature.name, sxx.name, sxy.name, syy.name
                 );
-                return Err(TextureSpec::FEATURE.error(
-                    spec.feature.unwrap_or(f64::NAN),
-                    format!("give either `{f}` or the spectrum `{xx}` (with optional `{xy}`, `{yy}`)"),
-                ));
+                // Neither form, or `feature` with a part of the spectrum: said of that part.
+                return Err(
+                    match (
+                        f,
+                        [(sxx, spec.sxx), (sxy, spec.sxy), (syy, spec.syy)]
+                            .into_iter()
+                            .find(|(_, v)| v.is_some()),
+                    ) {
+                        (Some(_), Some((part, _))) => {
+                            part.choice(format!("not with `{}`; {forms}", feature.name))
+                        }
+                        _ => feature.choice(format!("missing; {forms}")),
+                    },
+                );
             }
         };
         // PSD, with a relative tolerance for rounding in the caller's products.

@@ -375,6 +375,27 @@ fn open_bracket(chars: &[char], at: usize) -> Option<(usize, usize)> {
     }
 }
 
+/// Where the bracket left open before index `at` of `chars` (a [`code_of`]) is, and the
+/// bracket that closes it, when `chars[at]` is a closing bracket: `None` for any other
+/// character, or outside brackets.
+fn open_for_close(chars: &[char], at: usize) -> Option<(usize, char)> {
+    if !matches!(chars.get(at)?, ')' | ']' | '}') {
+        return None;
+    }
+    let mut depth = 0usize;
+    for i in (0..at).rev() {
+        match chars[i] {
+            ')' | ']' | '}' => depth += 1,
+            '(' if depth == 0 => return Some((i, ')')),
+            '[' if depth == 0 => return Some((i, ']')),
+            '{' if depth == 0 => return Some((i, '}')),
+            '(' | '[' | '{' => depth -= 1,
+            _ => {}
+        }
+    }
+    None
+}
+
 /// The first whitespace character other than an ASCII space, tab or line break (a
 /// no-break space U+00A0, an em space, an ideographic space…) outside comments and strings,
 /// before `(line, col)` or in the whitespace just after it: RON does not read it as space, and reports whatever it
@@ -567,6 +588,24 @@ pub fn token_error(text: &str, line: usize, col: usize, message: &str) -> Option
                 cov_core::echo(&token(&written, i))
             ),
         ));
+    }
+    // A closing bracket of the wrong kind: the list's `]` (or a struct's `)`) left off
+    // before the bracket that closes the level around it.
+    if let Some(i) = next
+        && let Some((open, want)) = open_for_close(&chars, i)
+        && want != chars[i]
+    {
+        let (l, c) = pos[open];
+        let (found, opened) = (chars[i], chars[open]);
+        let words = match field_at(text, l, c) {
+            Some((name, _, _)) => format!(
+                "this `{found}` would close `{name}`, whose `{opened}` at {l}:{c} only a `{want}` closes: is its `{want}` missing?"
+            ),
+            None => format!(
+                "this `{found}` would close the `{opened}` at {l}:{c}, which only a `{want}` closes: is a `{want}` missing before it?"
+            ),
+        };
+        return Some((pos[i], words));
     }
     // A name where a map's key, a string, belongs: `white: Diffuse(…)`.
     if message.starts_with("Expected string")
@@ -972,5 +1011,31 @@ mod tests {
         let text = "S(\n  c: (a: 1,\n  b: 2)\n)";
         assert_eq!(enclosing_field(text, 3, 3), Some(("c".to_string(), (2, 3))));
         assert_eq!(enclosing_field("[(a: 1)]", 1, 3), None);
+    }
+
+    /// A list's `]` left off before the `)` of the struct around it is said at that `)`,
+    /// naming the `[` it leaves open; a bracket of the right kind is no such mistake.
+    #[test]
+    fn a_closing_bracket_of_the_wrong_kind() {
+        let text = "P(ops: [\n  T(d: 1),\n  W(s: 2),\n)";
+        let (at, words) = token_error(text, 4, 1, "Expected identifier").expect("found");
+        assert_eq!(at, (4, 1));
+        assert!(
+            words.contains("`)` would close `ops`, whose `[` at 1:8") && words.contains("`]` missing"),
+            "{words}"
+        );
+        let (at, words) = token_error("P(a: (1, 2], b: 3)", 1, 11, "Expected comma").expect("found");
+        assert_eq!(at, (1, 11));
+        assert!(words.contains("`]` would close `a`, whose `(` at 1:6"), "{words}");
+        let (_, words) = token_error("[(1, 2]", 1, 7, "Expected comma").expect("found");
+        assert!(
+            words.contains("`]` would close the `(` at 1:2, which only a `)` closes"),
+            "{words}"
+        );
+        // A `)` where a `)` belongs: another mistake, not this one.
+        assert!(
+            token_error("P(a: (1, 2), b: 3)", 1, 12, "Expected comma")
+                .is_none_or(|(_, w)| !w.contains("would close"))
+        );
     }
 }

@@ -50,7 +50,7 @@
 //! | `shapes` | | `Sphere(center, radius, material, velocity, spin)` (`spin`: rad/s about the centre, axis times rate, at most [`MAX_ANGULAR_VELOCITY`]; a ball rolling at `v` on a floor of normal `up` spins at `up × v / r`), `Quad(corner, edge_u, edge_v, material, velocity)`, `Mesh(obj, material, translate, scale, rotate, velocity)` (`rotate`: degrees about the world's `x`, then `y`, then `z` axes through the mesh's origin, after `scale` and before `translate`; one material for the whole mesh: the OBJ's `mtllib` and `usemtl` lines are not read, and `usemtl` lines naming several materials are a warning: split such a file, one OBJ and one `Mesh` per material; a mesh without texture coordinates `vt` reads its material's texture at `(0, 0)`) |
 //! | colours (`albedo`, texture colours, `radiance`) | | each entry 0 to [`MAX_COLOUR`] (1e9) as it is read; a material's `albedo` and a texture's colours at most 1 (a surface reflects no more than it receives) |
 //! | every shape and light | m | within ±[`crate::geometry::MAX_COORD`] (1e12) of the origin, with its motion over the shutter (and at every frame rendered) |
-//! | copies | | at most [`MAX_SHARED_BOX`] (256) shapes, lights and triangles lying exactly on one another (the BVH builder's time grows as the square of their number); at most [`MAX_TRIANGLES`] triangles over all meshes, each placement counted |
+//! | copies | | at most [`MAX_SHARED_BOX`] (256) shapes, lights and mesh triangles lying exactly on one another (a quad counts once) (the BVH builder's time grows as the square of their number); at most [`MAX_TRIANGLES`] triangles over all meshes, each placement counted |
 //! | a sphere's radius, a quad's or rect light's edges, a mesh's extent | m | at least [`crate::geometry::MIN_SIZE`] × (1 m + the largest \|coordinate\| of its centre or corner) |
 
 use std::collections::BTreeMap;
@@ -250,8 +250,8 @@ pub struct SceneFile {
     pub materials: BTreeMap<At<String>, MaterialDesc>,
     /// Emitters.
     pub lights: At<Vec<LightDesc>>,
-    /// Geometry.
-    pub shapes: Vec<ShapeDesc>,
+    /// Geometry (empty is a warning: light falls on nothing).
+    pub shapes: At<Vec<ShapeDesc>>,
 }
 
 /// A map of names to definitions in which a name given twice is an error (where the

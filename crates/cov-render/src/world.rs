@@ -475,11 +475,8 @@ impl World {
             materials(&desc, &Names(&texture_names, "texture")).map_err(|(o, m)| at(o, m))?;
         let mut prims = Vec::new();
         let (t0, t1) = camera.shutter.unwrap_or((0.0, 0.0));
-        let lights = lights(&desc, &mut prims).map_err(|(o, m)| at(o, m))?;
         let mut boxes = SharedBoxes::default();
-        boxes
-            .add(&prims, 0, (t0, t1), desc.lights.ordinal)
-            .map_err(|(o, m)| at(o, m))?;
+        let lights = lights(&desc, &mut prims, &mut boxes).map_err(|(o, m)| at(o, m))?;
         let names = Names(&material_names, "material");
         let mut warnings = Vec::new();
         let any_velocity = shapes(
@@ -1016,8 +1013,9 @@ impl Names<'_> {
     }
 }
 
-/// The lights; emitters are also geometry (the camera sees them), added to `prims`.
-fn lights(desc: &SceneFile, prims: &mut Vec<Prim>) -> Result<Vec<Light>, Failure> {
+/// The lights; emitters are also geometry (the camera sees them), added to `prims`, their
+/// boxes counted in `boxes`.
+fn lights(desc: &SceneFile, prims: &mut Vec<Prim>, boxes: &mut SharedBoxes) -> Result<Vec<Light>, Failure> {
     let mut lights = Vec::new();
     for l in &desc.lights.value {
         let index = lights.len() as u32;
@@ -1080,6 +1078,7 @@ fn lights(desc: &SceneFile, prims: &mut Vec<Prim>) -> Result<Vec<Light>, Failure
         }
         // Lights do not move: their reach is the same at every instant.
         within_reach(prims, from, 0.0, 0.0, place, "light")?;
+        boxes.add(prims, from, (0.0, 0.0), (place, true))?;
     }
     if lights.is_empty() {
         return Err((
@@ -1116,7 +1115,7 @@ fn large_enough(desc: &SceneFile) -> Result<(), Failure> {
             LightDesc::Sphere { center, radius, .. } => sizes.push(sphere(&center.value, radius)),
         }
     }
-    for s in &desc.shapes {
+    for s in &desc.shapes.value {
         match s {
             ShapeDesc::Quad {
                 corner,
@@ -1190,23 +1189,31 @@ fn beyond_reach(what: &str, reach: f64) -> String {
 struct SharedBoxes(HashMap<[u32; 6], u32>);
 
 impl SharedBoxes {
-    /// Counts the boxes of `prims[from..]` over the shutter; `Err` at `ordinal` when one is
-    /// held by more than [`MAX_SHARED_BOX`] primitives.
+    /// Counts the boxes of `prims[from..]`, the primitives of one shape or light, over the
+    /// shutter; `Err` at `ordinal` when one is held by more than [`MAX_SHARED_BOX`]. With
+    /// `per_shape`, a box the shape's own primitives share counts once (a quad's two
+    /// triangles; the user counts the copies of the quad, and the BVH builds 512 equal
+    /// boxes in milliseconds); a mesh's triangles count each, as the file may repeat one.
     fn add(
         &mut self,
         prims: &[Prim],
         from: usize,
         (t0, t1): (f64, f64),
-        ordinal: u32,
+        (ordinal, per_shape): (u32, bool),
     ) -> Result<(), Failure> {
-        for p in &prims[from..] {
-            let n = self.0.entry(p.box_key(t0, t1)).or_insert(0);
+        let mut keys: Vec<[u32; 6]> = prims[from..].iter().map(|p| p.box_key(t0, t1)).collect();
+        if per_shape {
+            keys.sort_unstable();
+            keys.dedup();
+        }
+        for key in keys {
+            let n = self.0.entry(key).or_insert(0);
             *n += 1;
             if *n > MAX_SHARED_BOX {
                 return Err((
                     ordinal,
                     format!(
-                        "more than {MAX_SHARED_BOX} shapes, lights or triangles lie exactly on one another here (copies of one shape in one place): only one of them can be seen; remove the copies"
+                        "more than {MAX_SHARED_BOX} shapes, lights or mesh triangles lie exactly on one another here (copies of one shape in one place): only one of them can be seen; remove the copies"
                     ),
                 ));
             }
@@ -1234,7 +1241,13 @@ fn shapes(
     let memory = crate::memory::available_memory();
     // Each OBJ file is read once, however many meshes place it.
     let mut read: HashMap<std::path::PathBuf, Obj> = HashMap::new();
-    for s in &desc.shapes {
+    if desc.shapes.value.is_empty() {
+        warnings.push((
+            desc.shapes.ordinal,
+            "`shapes` is empty: the camera sees the lights alone, and their light falls on nothing".into(),
+        ));
+    }
+    for s in &desc.shapes.value {
         let from = prims.len();
         let (material, velocity) = match s {
             ShapeDesc::Sphere {
@@ -1396,7 +1409,8 @@ fn shapes(
             ShapeDesc::Quad { corner, .. } => (corner.ordinal, "quad"),
         };
         within_reach(prims, from, t0, t1, ordinal, what)?;
-        boxes.add(prims, from, (t0, t1), ordinal)?;
+        let per_shape = !matches!(s, ShapeDesc::Mesh { .. });
+        boxes.add(prims, from, (t0, t1), (ordinal, per_shape))?;
     }
     Ok(any_velocity)
 }
@@ -1728,7 +1742,7 @@ fn input_files(desc: &SceneFile, dir: &Path) -> Vec<std::path::PathBuf> {
         TextureDesc::Image { file, .. } => Some(dir.join(&file.value)),
         _ => None,
     });
-    let meshes = desc.shapes.iter().filter_map(|s| match s {
+    let meshes = desc.shapes.value.iter().filter_map(|s| match s {
         ShapeDesc::Mesh { obj, .. } => Some(dir.join(&obj.value)),
         _ => None,
     });

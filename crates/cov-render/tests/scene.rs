@@ -1116,11 +1116,24 @@ fn copies_of_one_shape_in_one_place_are_refused() {
     let col = 29 + 61 * 256;
     assert!(
         e.starts_with(&format!(
-            "5:{col}: more than 256 shapes, lights or triangles lie exactly on one another"
+            "5:{col}: more than 256 shapes, lights or mesh triangles lie exactly on one another"
         )),
         "{e}"
     );
     assert!(World::from_text(&scene(&[("SHAPE", &copies(255))]), "s.ron", Path::new(".")).is_ok());
+    // A quad is two triangles in one box: it counts once, so the 257th quad is refused,
+    // not the 129th. Lights likewise.
+    let quad =
+        r#"Quad(corner: (5.0, 0.0, 0.0), edge_u: (1.0, 0.0, 0.0), edge_v: (0.0, 1.0, 0.0), material: "w")"#;
+    let quads = |n: usize| vec![quad; n].join(", ");
+    assert!(World::from_text(&scene(&[("SHAPE", &quads(256))]), "s.ron", Path::new(".")).is_ok());
+    let e = error(&scene(&[("SHAPE", &quads(257))]));
+    assert!(e.contains("more than 256 shapes"), "{e}");
+    let rect = r#"Rect(corner: (5.0, 3.0, 0.0), edge_u: (1.0, 0.0, 0.0), edge_v: (0.0, 0.0, 1.0), radiance: (1.0, 1.0, 1.0))"#;
+    let rects = |n: usize| format!("[{}]", vec![rect; n].join(", "));
+    assert!(World::from_text(&scene(&[("LIGHTS", &rects(256))]), "s.ron", Path::new(".")).is_ok());
+    let e = error(&scene(&[("LIGHTS", &rects(257))]));
+    assert!(e.contains("more than 256 shapes"), "{e}");
 }
 
 /// A number in another base where a decimal belongs says so, at its field (ron reads the
@@ -1185,4 +1198,24 @@ fn an_obj_of_several_materials_is_a_warning() {
     );
     assert!(world("one.obj").warnings.is_empty());
     let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// A scene without shapes loads (the lights are seen) and says, once, at `shapes`, that
+/// light falls on nothing; a scene with a shape says nothing.
+#[test]
+fn a_scene_without_shapes_is_a_warning() {
+    let text = scene(&[]).replace(
+        r#"[Sphere(center: (0.0, 0.5, 0.0), radius: 0.5, material: "w")]"#,
+        "[]",
+    );
+    assert!(text.contains("shapes: []"), "{text}");
+    let w = World::from_text(&text, "s.ron", Path::new(".")).expect("loads");
+    assert_eq!(w.warnings.len(), 1, "{:?}", w.warnings);
+    assert!(
+        w.warnings[0].starts_with("s.ron:5:13: `shapes` is empty"),
+        "{}",
+        w.warnings[0]
+    );
+    let w = World::from_text(&scene(&[]), "s.ron", Path::new(".")).expect("loads");
+    assert!(w.warnings.is_empty(), "{:?}", w.warnings);
 }
